@@ -1,0 +1,631 @@
+//! The case-file expression language and its lowering to trigonometric polynomials.
+//!
+//! Grammar: numbers, parameter and coordinate names, `pi`, binary `+ - * /`, `^` with a
+//! non-negative integer exponent, unary minus, parentheses, and `cos(..)`, `sin(..)` of an angle
+//! expression. Everything a trigonometric polynomial cannot hold is refused with the offending
+//! part named: other functions (`sqrt`, `atan2`), division by anything that is not constant
+//! (`1/th2`), non-integer or negative powers, bare angles outside `cos`/`sin`, and `cos`/`sin` of
+//! anything but an integer combination of angle coordinates plus a constant (`cos(th1*th2)`,
+//! `cos(th1/2)`).
+
+use std::collections::BTreeMap;
+
+use crate::angle::LinearAngle;
+use crate::monomial::VarKind;
+use crate::poly::TrigPoly;
+
+/// Why an expression was refused: the whole expression, the offending part and the reason.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("expression `{expr}`: {reason} (at `{part}`)")]
+pub struct ExprError {
+    pub expr: String,
+    pub part: String,
+    pub reason: String,
+}
+
+/// Names known to expressions: numeric parameters and the chart coordinates (index = position).
+#[derive(Clone, Debug, Default)]
+pub struct ExprContext {
+    parameters: BTreeMap<String, f64>,
+    coordinates: Vec<(String, VarKind)>,
+}
+
+impl ExprContext {
+    pub fn new(parameters: BTreeMap<String, f64>, coordinates: Vec<(String, VarKind)>) -> Self {
+        ExprContext {
+            parameters,
+            coordinates,
+        }
+    }
+
+    pub fn coordinates(&self) -> &[(String, VarKind)] {
+        &self.coordinates
+    }
+
+    /// Parses an expression that must be a trigonometric polynomial in the coordinates.
+    pub fn parse_poly(&self, src: &str) -> Result<TrigPoly, ExprError> {
+        let (ast, span) = self.parse(src)?;
+        match self.lower(src, &ast)? {
+            Value::Poly(p) => Ok(p),
+            Value::Affine(a) if a.angles.is_empty() => Ok(TrigPoly::constant(a.constant)),
+            Value::Affine(_) => Err(error(
+                src,
+                span,
+                "a bare angle is not a trigonometric polynomial; use cos(..) or sin(..)",
+            )),
+        }
+    }
+
+    /// Parses an angle: an integer combination of angle coordinates plus a constant.
+    pub fn parse_angle(&self, src: &str) -> Result<LinearAngle, ExprError> {
+        let (ast, span) = self.parse(src)?;
+        let value = self.lower(src, &ast)?;
+        to_angle(src, span, value)
+    }
+
+    /// Parses an expression that must not depend on any coordinate.
+    pub fn parse_constant(&self, src: &str) -> Result<f64, ExprError> {
+        let (ast, span) = self.parse(src)?;
+        match self.lower(src, &ast)? {
+            Value::Affine(a) if a.angles.is_empty() => Ok(a.constant),
+            Value::Poly(p) if p.is_constant() => Ok(p.constant_term()),
+            _ => Err(error(src, span, "must be a constant (no coordinates)")),
+        }
+    }
+
+    fn parse(&self, src: &str) -> Result<(Node, Span), ExprError> {
+        let tokens = tokenize(src)?;
+        let mut parser = Parser {
+            src,
+            tokens,
+            pos: 0,
+        };
+        let node = parser.expression(0)?;
+        if let Some(tok) = parser.tokens.get(parser.pos) {
+            return Err(error(src, tok.span, "unexpected token"));
+        }
+        let span = node.span;
+        Ok((node, span))
+    }
+
+    fn lower(&self, src: &str, node: &Node) -> Result<Value, ExprError> {
+        let span = node.span;
+        match &node.kind {
+            NodeKind::Number(x) => Ok(Value::constant(*x)),
+            NodeKind::Name(name) => self.lower_name(src, span, name),
+            NodeKind::Neg(inner) => Ok(self.lower(src, inner)?.scale(-1.0)),
+            NodeKind::Binary(op, lhs, rhs) => {
+                let a = self.lower(src, lhs)?;
+                let b = self.lower(src, rhs)?;
+                match op {
+                    '+' => add(src, span, a, b, 1.0),
+                    '-' => add(src, span, a, b, -1.0),
+                    '*' => multiply(src, span, a, b),
+                    '/' => {
+                        let divisor = b.as_constant().ok_or_else(|| {
+                            error(src, rhs.span, "division by a non-constant expression")
+                        })?;
+                        if divisor == 0.0 {
+                            return Err(error(src, rhs.span, "division by zero"));
+                        }
+                        Ok(a.scale(1.0 / divisor))
+                    }
+                    '^' => {
+                        let exponent = b.as_constant().ok_or_else(|| {
+                            error(src, rhs.span, "exponent must be a constant integer")
+                        })?;
+                        if exponent < 0.0 || exponent.fract() != 0.0 || exponent > 64.0 {
+                            return Err(error(
+                                src,
+                                rhs.span,
+                                "exponent must be an integer between 0 and 64",
+                            ));
+                        }
+                        power(src, lhs.span, a, exponent as u32)
+                    }
+                    _ => unreachable!("parser only builds + - * / ^"),
+                }
+            }
+            NodeKind::Call(function, args) => {
+                if function != "cos" && function != "sin" {
+                    return Err(error(
+                        src,
+                        span,
+                        &format!("function `{function}` is not allowed (only cos and sin)"),
+                    ));
+                }
+                if args.len() != 1 {
+                    return Err(error(src, span, "cos and sin take exactly one argument"));
+                }
+                let argument = self.lower(src, &args[0])?;
+                let angle = to_angle(src, args[0].span, argument)?;
+                let (c, s) = angle.cos_sin();
+                Ok(Value::Poly(if function == "cos" { c } else { s }))
+            }
+        }
+    }
+
+    fn lower_name(&self, src: &str, span: Span, name: &str) -> Result<Value, ExprError> {
+        if let Some(k) = self.coordinates.iter().position(|(n, _)| n == name) {
+            return Ok(match self.coordinates[k].1 {
+                VarKind::Angle => Value::Affine(Affine {
+                    angles: BTreeMap::from([(k, 1.0)]),
+                    constant: 0.0,
+                }),
+                VarKind::Length => Value::Poly(TrigPoly::length(k)),
+            });
+        }
+        if let Some(&value) = self.parameters.get(name) {
+            return Ok(Value::constant(value));
+        }
+        if name == "pi" {
+            return Ok(Value::constant(std::f64::consts::PI));
+        }
+        Err(error(
+            src,
+            span,
+            "unknown name (not a parameter or coordinate)",
+        ))
+    }
+}
+
+/// An intermediate value: either a trigonometric polynomial, or an affine combination of bare
+/// angle coordinates (which is only valid inside `cos`/`sin` or as a rotation angle).
+#[derive(Clone, Debug)]
+enum Value {
+    Poly(TrigPoly),
+    Affine(Affine),
+}
+
+#[derive(Clone, Debug, Default)]
+struct Affine {
+    angles: BTreeMap<usize, f64>,
+    constant: f64,
+}
+
+impl Value {
+    fn constant(c: f64) -> Value {
+        Value::Affine(Affine {
+            angles: BTreeMap::new(),
+            constant: c,
+        })
+    }
+
+    fn as_constant(&self) -> Option<f64> {
+        match self {
+            Value::Affine(a) if a.angles.is_empty() => Some(a.constant),
+            Value::Poly(p) if p.is_constant() => Some(p.constant_term()),
+            _ => None,
+        }
+    }
+
+    fn scale(self, s: f64) -> Value {
+        match self {
+            Value::Poly(p) => Value::Poly(p.scale(s)),
+            Value::Affine(a) => Value::Affine(Affine {
+                angles: a.angles.into_iter().map(|(k, n)| (k, n * s)).collect(),
+                constant: a.constant * s,
+            }),
+        }
+    }
+}
+
+fn bare_angle_error(src: &str, span: Span) -> ExprError {
+    error(
+        src,
+        span,
+        "a bare angle cannot be combined with a polynomial; use cos(..) or sin(..)",
+    )
+}
+
+fn add(src: &str, span: Span, a: Value, b: Value, sign: f64) -> Result<Value, ExprError> {
+    match (a, b.scale(sign)) {
+        (Value::Affine(mut x), Value::Affine(y)) => {
+            for (k, n) in y.angles {
+                *x.angles.entry(k).or_insert(0.0) += n;
+            }
+            x.angles.retain(|_, n| *n != 0.0);
+            x.constant += y.constant;
+            Ok(Value::Affine(x))
+        }
+        (Value::Poly(p), Value::Affine(a)) | (Value::Affine(a), Value::Poly(p)) => {
+            if !a.angles.is_empty() {
+                return Err(bare_angle_error(src, span));
+            }
+            Ok(Value::Poly(&p + &TrigPoly::constant(a.constant)))
+        }
+        (Value::Poly(p), Value::Poly(q)) => Ok(Value::Poly(&p + &q)),
+    }
+}
+
+fn multiply(src: &str, span: Span, a: Value, b: Value) -> Result<Value, ExprError> {
+    if let Some(c) = a.as_constant() {
+        return Ok(b.scale(c));
+    }
+    if let Some(c) = b.as_constant() {
+        return Ok(a.scale(c));
+    }
+    match (a, b) {
+        (Value::Poly(p), Value::Poly(q)) => Ok(Value::Poly(&p * &q)),
+        (Value::Affine(_), Value::Affine(_)) => Err(error(
+            src,
+            span,
+            "a product of angles is not a trigonometric polynomial",
+        )),
+        _ => Err(bare_angle_error(src, span)),
+    }
+}
+
+fn power(src: &str, span: Span, a: Value, n: u32) -> Result<Value, ExprError> {
+    if let Some(c) = a.as_constant() {
+        return Ok(Value::constant(c.powi(n as i32)));
+    }
+    match a {
+        Value::Poly(p) => Ok(Value::Poly(p.pow(n))),
+        Value::Affine(_) if n == 1 => Ok(a),
+        Value::Affine(_) => Err(error(
+            src,
+            span,
+            "a power of an angle is not a trigonometric polynomial",
+        )),
+    }
+}
+
+fn to_angle(src: &str, span: Span, value: Value) -> Result<LinearAngle, ExprError> {
+    let affine = match value {
+        Value::Affine(a) => a,
+        Value::Poly(p) if p.is_constant() => Affine {
+            angles: BTreeMap::new(),
+            constant: p.constant_term(),
+        },
+        Value::Poly(_) => {
+            return Err(error(
+                src,
+                span,
+                "an angle must be an integer combination of angle coordinates plus a constant",
+            ));
+        }
+    };
+    let mut terms = Vec::new();
+    for (k, n) in affine.angles {
+        let rounded = n.round();
+        if (n - rounded).abs() > 1e-12 || rounded.abs() > 64.0 {
+            return Err(error(
+                src,
+                span,
+                &format!("angle multiples must be integers (found {n})"),
+            ));
+        }
+        if rounded != 0.0 {
+            terms.push((k, rounded as i32));
+        }
+    }
+    Ok(LinearAngle {
+        terms,
+        offset: affine.constant,
+    })
+}
+
+// ---------------------------------------------------------------- tokens and parser
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Span {
+    start: usize,
+    end: usize,
+}
+
+impl Span {
+    fn join(self, other: Span) -> Span {
+        Span {
+            start: self.start.min(other.start),
+            end: self.end.max(other.end),
+        }
+    }
+}
+
+fn error(src: &str, span: Span, reason: &str) -> ExprError {
+    ExprError {
+        expr: src.to_string(),
+        part: src.get(span.start..span.end).unwrap_or(src).to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Tok {
+    Number(f64),
+    Name(String),
+    Op(char),
+    Open,
+    Close,
+    Comma,
+}
+
+#[derive(Clone, Debug)]
+struct Token {
+    tok: Tok,
+    span: Span,
+}
+
+fn tokenize(src: &str) -> Result<Vec<Token>, ExprError> {
+    let bytes = src.as_bytes();
+    let mut tokens = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        let ch = bytes[i] as char;
+        let start = i;
+        if ch.is_ascii_whitespace() {
+            i += 1;
+            continue;
+        }
+        let tok = if ch.is_ascii_digit() || ch == '.' {
+            while i < bytes.len() && (bytes[i].is_ascii_digit() || bytes[i] == b'.') {
+                i += 1;
+            }
+            if i < bytes.len() && (bytes[i] == b'e' || bytes[i] == b'E') {
+                let mut j = i + 1;
+                if j < bytes.len() && (bytes[j] == b'+' || bytes[j] == b'-') {
+                    j += 1;
+                }
+                if j < bytes.len() && bytes[j].is_ascii_digit() {
+                    i = j;
+                    while i < bytes.len() && bytes[i].is_ascii_digit() {
+                        i += 1;
+                    }
+                }
+            }
+            let text = &src[start..i];
+            let value: f64 = text
+                .parse()
+                .map_err(|_| error(src, Span { start, end: i }, "malformed number"))?;
+            Tok::Number(value)
+        } else if ch.is_ascii_alphabetic() || ch == '_' {
+            while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_') {
+                i += 1;
+            }
+            Tok::Name(src[start..i].to_string())
+        } else {
+            i += 1;
+            match ch {
+                '+' | '-' | '*' | '/' | '^' => Tok::Op(ch),
+                '(' => Tok::Open,
+                ')' => Tok::Close,
+                ',' => Tok::Comma,
+                _ => {
+                    // Step over a whole UTF-8 character so the span stays on a boundary.
+                    while i < bytes.len() && !src.is_char_boundary(i) {
+                        i += 1;
+                    }
+                    return Err(error(src, Span { start, end: i }, "unexpected character"));
+                }
+            }
+        };
+        tokens.push(Token {
+            tok,
+            span: Span { start, end: i },
+        });
+    }
+    if tokens.is_empty() {
+        return Err(ExprError {
+            expr: src.to_string(),
+            part: src.to_string(),
+            reason: "empty expression".to_string(),
+        });
+    }
+    Ok(tokens)
+}
+
+#[derive(Clone, Debug)]
+struct Node {
+    kind: NodeKind,
+    span: Span,
+}
+
+#[derive(Clone, Debug)]
+enum NodeKind {
+    Number(f64),
+    Name(String),
+    Neg(Box<Node>),
+    Binary(char, Box<Node>, Box<Node>),
+    Call(String, Vec<Node>),
+}
+
+struct Parser<'a> {
+    src: &'a str,
+    tokens: Vec<Token>,
+    pos: usize,
+}
+
+/// Binding powers (left, right): `^` is right-associative and binds tighter than unary minus.
+fn infix_power(op: char) -> (u8, u8) {
+    match op {
+        '+' | '-' => (1, 2),
+        '*' | '/' => (3, 4),
+        '^' => (8, 7),
+        _ => unreachable!(),
+    }
+}
+
+const UNARY_MINUS_POWER: u8 = 5;
+
+impl Parser<'_> {
+    fn peek(&self) -> Option<&Token> {
+        self.tokens.get(self.pos)
+    }
+
+    fn end_span(&self) -> Span {
+        let end = self.src.len();
+        Span { start: 0, end }
+    }
+
+    fn expression(&mut self, min_power: u8) -> Result<Node, ExprError> {
+        let mut lhs = self.prefix()?;
+        while let Some(Token {
+            tok: Tok::Op(op), ..
+        }) = self.peek().cloned()
+        {
+            let (left, right) = infix_power(op);
+            if left < min_power {
+                break;
+            }
+            self.pos += 1;
+            let rhs = self.expression(right)?;
+            let span = lhs.span.join(rhs.span);
+            lhs = Node {
+                kind: NodeKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+                span,
+            };
+        }
+        Ok(lhs)
+    }
+
+    fn prefix(&mut self) -> Result<Node, ExprError> {
+        let Some(token) = self.peek().cloned() else {
+            return Err(error(
+                self.src,
+                self.end_span(),
+                "unexpected end of expression",
+            ));
+        };
+        self.pos += 1;
+        match token.tok {
+            Tok::Number(x) => Ok(Node {
+                kind: NodeKind::Number(x),
+                span: token.span,
+            }),
+            Tok::Op('-') => {
+                let inner = self.expression(UNARY_MINUS_POWER)?;
+                let span = token.span.join(inner.span);
+                Ok(Node {
+                    kind: NodeKind::Neg(Box::new(inner)),
+                    span,
+                })
+            }
+            Tok::Op('+') => self.expression(UNARY_MINUS_POWER),
+            Tok::Open => {
+                let inner = self.expression(0)?;
+                self.expect_close(token.span)?;
+                Ok(inner)
+            }
+            Tok::Name(name) => {
+                if matches!(self.peek(), Some(Token { tok: Tok::Open, .. })) {
+                    self.pos += 1;
+                    let mut args = vec![self.expression(0)?];
+                    while matches!(
+                        self.peek(),
+                        Some(Token {
+                            tok: Tok::Comma,
+                            ..
+                        })
+                    ) {
+                        self.pos += 1;
+                        args.push(self.expression(0)?);
+                    }
+                    let close = self.expect_close(token.span)?;
+                    Ok(Node {
+                        kind: NodeKind::Call(name, args),
+                        span: token.span.join(close),
+                    })
+                } else {
+                    Ok(Node {
+                        kind: NodeKind::Name(name),
+                        span: token.span,
+                    })
+                }
+            }
+            _ => Err(error(self.src, token.span, "unexpected token")),
+        }
+    }
+
+    fn expect_close(&mut self, open: Span) -> Result<Span, ExprError> {
+        match self.peek() {
+            Some(Token {
+                tok: Tok::Close,
+                span,
+            }) => {
+                let span = *span;
+                self.pos += 1;
+                Ok(span)
+            }
+            _ => Err(error(self.src, open, "unclosed parenthesis")),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Point;
+
+    fn context() -> ExprContext {
+        ExprContext::new(
+            BTreeMap::from([("d1".to_string(), 0.3), ("d4".to_string(), 0.25)]),
+            vec![
+                ("th1".to_string(), VarKind::Angle),
+                ("th2".to_string(), VarKind::Angle),
+                ("rho".to_string(), VarKind::Length),
+            ],
+        )
+    }
+
+    const KINDS: [VarKind; 3] = [VarKind::Angle, VarKind::Angle, VarKind::Length];
+
+    #[test]
+    fn evaluates_like_the_formula() {
+        let ctx = context();
+        let p = ctx
+            .parse_poly("d1*cos(th1) - d4*sin(2*th2 - th1 + pi/4)^2 + rho^3/2 - -1")
+            .unwrap();
+        let q = [0.4, -0.9, 1.7];
+        let expected = 0.3 * 0.4f64.cos()
+            - 0.25
+                * (2.0 * -0.9 - 0.4 + std::f64::consts::FRAC_PI_4)
+                    .sin()
+                    .powi(2)
+            + 1.7f64.powi(3) / 2.0
+            + 1.0;
+        assert!((p.eval(&Point::new(&q, &KINDS)) - expected).abs() < 1e-13);
+    }
+
+    #[test]
+    fn power_binds_tighter_than_unary_minus() {
+        let ctx = context();
+        assert_eq!(ctx.parse_constant("-2^2").unwrap(), -4.0);
+        assert_eq!(ctx.parse_constant("2^3^2").unwrap(), 512.0);
+        assert_eq!(ctx.parse_constant("1e-3*2").unwrap(), 0.002);
+    }
+
+    #[test]
+    fn angle_parse() {
+        let ctx = context();
+        let a = ctx.parse_angle("-th2 + 2*th1 + pi/2").unwrap();
+        assert_eq!(a.terms, vec![(0, 2), (1, -1)]);
+        assert!((a.offset - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    }
+
+    fn refused(src: &str, part: &str) {
+        let err = context().parse_poly(src).unwrap_err();
+        assert_eq!(err.part, part, "{err}");
+        assert!(err.to_string().contains(src), "{err}");
+    }
+
+    #[test]
+    fn refuses_what_is_not_a_trig_polynomial() {
+        refused("sqrt(2)", "sqrt(2)");
+        refused("1 + atan2(th1, th2)", "atan2(th1, th2)");
+        refused("cos(th1*th2)", "th1*th2");
+        refused("1/th2", "th2");
+        refused("d1/rho", "rho");
+        refused("cos(th1/2)", "th1/2");
+        refused("cos(rho)", "rho");
+        refused("th1 + cos(th2)", "th1 + cos(th2)");
+        refused("th1", "th1");
+        refused("rho^-1", "-1");
+        refused("rho^0.5", "0.5");
+        refused("foo + 1", "foo");
+        refused("cos(th1", "cos");
+        refused("(th1 + 2", "(");
+        refused("2 $ 3", "$");
+        refused("1 2", "2");
+    }
+}
