@@ -1,0 +1,1073 @@
+//! From a parsed [`Case`] to a validated [`Model`].
+//!
+//! The validator keeps going after a problem so that all of them are reported at once; a
+//! check that depends on an earlier failed one (the consistency of a joint whose body has a
+//! broken pose) is skipped rather than reported twice.
+
+use std::collections::{BTreeMap, HashMap};
+
+use counterpoise_symbolic::{ExprContext, MAX_VARS, Point, TrigPoly, VarKind};
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+
+use crate::case::{
+    BalancingSpec, Case, CoordinateKindSpec, Expr, JointKindSpec, LawSpec, PairsSpec, PlaneSpec,
+    Selection, ShapeSpec, TasksSpec,
+};
+use crate::error::{CaseErrors, ModelError};
+use crate::joints::{self, JointInput};
+use crate::model::{
+    Actuator, ActuatorMap, Balancing, Body, BodyId, Bounds, Coordinate, CounterweightOptions,
+    CounterweightShape, GridAxis, Joint, JointKind, Model, MotionLaw, PairMode, PathPayload,
+    Payload, Plane, SpringOptions, TaskPath, Tasks, Waypoint,
+};
+use crate::pose::{Parser, PolyPose};
+use crate::sampling::{DEFAULT_SEED, VALIDATION_SAMPLES, sample_configurations};
+
+/// Relative tolerance of the joint checks: deviations up to `JOINT_TOLERANCE · (1 + L)` pass,
+/// `L` being the characteristic length of the mechanism.
+pub const JOINT_TOLERANCE: f64 = 1e-9;
+
+/// Relative tolerance of the check that an actuated coordinate moves like its joint.
+pub const ACTUATOR_TOLERANCE: f64 = 1e-8;
+
+/// Names the expression language reserves.
+const RESERVED: [&str; 3] = ["pi", "cos", "sin"];
+
+fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+struct Validator {
+    errors: Vec<ModelError>,
+}
+
+impl Validator {
+    fn push(&mut self, error: ModelError) {
+        self.errors.push(error);
+    }
+
+    fn invalid(&mut self, path: impl Into<String>, reason: impl Into<String>) {
+        self.errors.push(ModelError::invalid(path, reason));
+    }
+
+    fn unknown(&mut self, path: impl Into<String>, what: &'static str, name: &str) {
+        self.errors.push(ModelError::UnknownName {
+            path: path.into(),
+            what,
+            name: name.to_string(),
+        });
+    }
+
+    /// Records a name in `seen`, reporting a duplicate; returns whether it was new.
+    fn unique(
+        &mut self,
+        seen: &mut HashMap<String, String>,
+        name: &str,
+        path: String,
+        what: &'static str,
+    ) -> bool {
+        if let Some(first) = seen.get(name) {
+            self.push(ModelError::Duplicate {
+                path,
+                what,
+                name: name.to_string(),
+                first: first.clone(),
+            });
+            false
+        } else {
+            seen.insert(name.to_string(), path);
+            true
+        }
+    }
+
+    fn name(&mut self, name: &str, path: &str) {
+        if name.trim().is_empty() {
+            self.invalid(path, "must not be empty");
+        }
+    }
+
+    fn finite(&mut self, values: &[f64], path: &str) -> bool {
+        let mut ok = true;
+        for (k, v) in values.iter().enumerate() {
+            if !v.is_finite() {
+                self.invalid(
+                    format!("{path}[{k}]"),
+                    format!("{v} is not a finite number"),
+                );
+                ok = false;
+            }
+        }
+        ok
+    }
+
+    fn positive(&mut self, value: f64, path: &str) -> bool {
+        if !(value.is_finite() && value > 0.0) {
+            self.invalid(path, format!("must be a finite number > 0 (found {value})"));
+            return false;
+        }
+        true
+    }
+
+    fn non_negative(&mut self, value: f64, path: &str) -> bool {
+        if !(value.is_finite() && value >= 0.0) {
+            self.invalid(path, format!("must be a finite number ≥ 0 (found {value})"));
+            return false;
+        }
+        true
+    }
+
+    /// The inertia tensor from `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]`, checked positive semi-definite.
+    fn inertia(&mut self, v: &[f64; 6], path: &str) -> Option<Matrix3<f64>> {
+        if !self.finite(v, path) {
+            return None;
+        }
+        let [ixx, iyy, izz, ixy, ixz, iyz] = *v;
+        let m = Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
+        let eigenvalues = SymmetricEigen::new(m).eigenvalues;
+        let trace = m.trace();
+        if eigenvalues.iter().any(|&e| e < -1e-9 * trace.abs()) {
+            let mut e: Vec<f64> = eigenvalues.iter().copied().collect();
+            e.sort_by(f64::total_cmp);
+            self.invalid(
+                path,
+                format!(
+                    "inertia is not positive semi-definite (principal moments {:.6}, {:.6}, {:.6} kg·m²)",
+                    e[0], e[1], e[2]
+                ),
+            );
+            return None;
+        }
+        Some(m)
+    }
+
+    /// A unit axis from a constant 3-vector; a zero vector is an error.
+    fn axis(&mut self, parser: &Parser, exprs: &[Expr; 3], path: &str) -> Option<Vector3<f64>> {
+        let v = Vector3::from(parser.constant_vec(exprs, path, &mut self.errors)?);
+        if v.norm() < 1e-12 {
+            self.invalid(path, "axis must not be zero");
+            return None;
+        }
+        Some(v.normalize())
+    }
+
+    fn interval(&mut self, v: [f64; 2], path: &str) -> Option<[f64; 2]> {
+        if !self.finite(&v, path) {
+            return None;
+        }
+        if v[0] < 0.0 || v[0] > v[1] {
+            self.invalid(
+                path,
+                format!(
+                    "must be [lo, hi] with 0 ≤ lo ≤ hi (found [{}, {}])",
+                    v[0], v[1]
+                ),
+            );
+            return None;
+        }
+        Some(v)
+    }
+}
+
+/// Validates a parsed case into a model, reporting every problem found.
+pub fn validate(case: Case) -> Result<Model, CaseErrors> {
+    let mut v = Validator { errors: Vec::new() };
+
+    v.name(&case.name, "name");
+    v.finite(&case.gravity, "gravity");
+
+    // ---- parameters and coordinates: the names expressions may use
+    let mut names: HashMap<String, String> = HashMap::new();
+    let mut parameters = BTreeMap::new();
+    for (name, &value) in case.parameters.iter() {
+        let path = format!("parameters.{name}");
+        if !is_identifier(name) || RESERVED.contains(&name) {
+            v.invalid(
+                &path,
+                format!(
+                    "`{name}` is not a valid parameter name (an identifier other than pi, cos, sin)"
+                ),
+            );
+        }
+        if !value.is_finite() {
+            v.invalid(&path, format!("{value} is not a finite number"));
+        }
+        names.insert(name.to_string(), path);
+        parameters.insert(name.to_string(), value);
+    }
+    if case.coordinates.len() > MAX_VARS {
+        v.invalid(
+            "coordinates",
+            format!(
+                "at most {MAX_VARS} coordinates are supported (found {})",
+                case.coordinates.len()
+            ),
+        );
+        return Err(CaseErrors { errors: v.errors });
+    }
+    let mut coordinates = Vec::new();
+    let mut coordinates_ok = true;
+    for (i, c) in case.coordinates.iter().enumerate() {
+        let path = format!("coordinates[{i}]");
+        if !is_identifier(&c.name) || RESERVED.contains(&c.name.as_str()) {
+            v.invalid(
+                format!("{path}.name"),
+                format!(
+                    "`{}` is not a valid coordinate name (an identifier other than pi, cos, sin)",
+                    c.name
+                ),
+            );
+            coordinates_ok = false;
+        }
+        coordinates_ok &= v.unique(&mut names, &c.name, format!("{path}.name"), "name");
+        let range_path = format!("{path}.range");
+        if !v.finite(&c.range, &range_path) {
+            coordinates_ok = false;
+        } else if c.range[0] >= c.range[1] {
+            v.invalid(
+                &range_path,
+                format!("min must be < max (found [{}, {}])", c.range[0], c.range[1]),
+            );
+            coordinates_ok = false;
+        }
+        coordinates.push(Coordinate {
+            name: c.name.clone(),
+            kind: match c.kind {
+                CoordinateKindSpec::Angle => VarKind::Angle,
+                CoordinateKindSpec::Length => VarKind::Length,
+            },
+            range: c.range,
+        });
+    }
+    let context = ExprContext::new(
+        parameters,
+        coordinates
+            .iter()
+            .map(|c| (c.name.clone(), c.kind))
+            .collect(),
+    );
+    let parser = Parser { context: &context };
+
+    // ---- bodies: names, parents, inertial data, poses
+    let mut body_names: HashMap<String, String> = HashMap::new();
+    for (i, b) in case.bodies.iter().enumerate() {
+        let path = format!("bodies[{i}].name");
+        v.name(&b.name, &path);
+        if b.name == "base" {
+            v.invalid(&path, "`base` is reserved for the fixed frame");
+        } else {
+            v.unique(&mut body_names, &b.name, path, "body");
+        }
+    }
+    let body_id = |name: &str| -> Option<BodyId> {
+        if name == "base" {
+            Some(BodyId::Base)
+        } else {
+            case.bodies
+                .iter()
+                .position(|b| b.name == name)
+                .map(BodyId::Body)
+        }
+    };
+    let mut parents = Vec::new();
+    for (i, b) in case.bodies.iter().enumerate() {
+        let parent = body_id(&b.parent);
+        if parent.is_none() {
+            v.unknown(format!("bodies[{i}].parent"), "body", &b.parent);
+        }
+        parents.push(parent);
+    }
+    let on_cycle = find_cycles(&mut v, &case, &parents);
+
+    let mut relative = Vec::new();
+    let mut inertial = Vec::new();
+    for (i, b) in case.bodies.iter().enumerate() {
+        let path = format!("bodies[{i}]");
+        relative.push(parser.pose(&b.pose, &format!("{path}.pose"), &mut v.errors));
+        v.non_negative(b.mass, &format!("{path}.mass"));
+        let com = match &b.com {
+            Some(e) => parser
+                .constant_vec(e, &format!("{path}.com"), &mut v.errors)
+                .map(Vector3::from),
+            None if b.mass > 0.0 => {
+                v.invalid(format!("{path}.com"), "required when mass > 0");
+                None
+            }
+            None => Some(Vector3::zeros()),
+        };
+        let inertia = match &b.inertia {
+            Some(values) => v.inertia(values, &format!("{path}.inertia")),
+            None if b.mass > 0.0 => {
+                v.invalid(format!("{path}.inertia"), "required when mass > 0");
+                None
+            }
+            None => Some(Matrix3::zeros()),
+        };
+        inertial.push((com, inertia));
+    }
+    let world = world_poses(&parents, &relative, &on_cycle);
+
+    // ---- payloads
+    let mut payloads = Vec::new();
+    for (i, p) in case.payloads.iter().enumerate() {
+        let path = format!("payloads[{i}]");
+        let body = carried_body(&mut v, &body_id, &p.body, &format!("{path}.body"));
+        v.non_negative(p.mass, &format!("{path}.mass"));
+        let com = parser.constant_vec(&p.com, &format!("{path}.com"), &mut v.errors);
+        let inertia = v.inertia(&p.inertia.unwrap_or([0.0; 6]), &format!("{path}.inertia"));
+        if let (Some(body), Some(com), Some(inertia)) = (body, com, inertia) {
+            payloads.push(Payload {
+                name: p
+                    .name
+                    .clone()
+                    .unwrap_or_else(|| format!("payload {}", i + 1)),
+                body,
+                mass: p.mass,
+                com: Vector3::from(com),
+                inertia_com: inertia,
+                in_balance: p.in_balance,
+            });
+        }
+    }
+
+    // ---- joints: shape first, then consistency at sampled configurations
+    let samples = sample_configurations(&coordinates, VALIDATION_SAMPLES, DEFAULT_SEED);
+    let all_poses: Option<Vec<PolyPose>> = world.iter().cloned().collect();
+    let length = characteristic_length(&case, &coordinates, &world, &parser, coordinates_ok);
+    let tolerance = JOINT_TOLERANCE * (1.0 + length);
+    let mut joint_names = HashMap::new();
+    let mut joints: Vec<Option<Joint>> = Vec::new();
+    for (i, j) in case.joints.iter().enumerate() {
+        let path = format!("joints[{i}]");
+        v.name(&j.name, &format!("{path}.name"));
+        v.unique(&mut joint_names, &j.name, format!("{path}.name"), "joint");
+        joints.push(
+            joint(&mut v, &parser, &body_id, j, &path).and_then(|input| {
+                let posed = input
+                    .bodies
+                    .iter()
+                    .all(|b| b.index().is_none_or(|k| world[k].is_some()));
+                if !(posed && coordinates_ok) {
+                    return None;
+                }
+                let poses: Vec<PolyPose> = world
+                    .iter()
+                    .map(|p| p.clone().unwrap_or_else(PolyPose::identity))
+                    .collect();
+                match joints::derive_and_check(&input, &poses, &coordinates, &samples, tolerance) {
+                    Ok(joint) => Some(joint),
+                    Err(errors) => {
+                        v.errors.extend(errors);
+                        None
+                    }
+                }
+            }),
+        );
+    }
+
+    // ---- actuators
+    let mut actuator_names = HashMap::new();
+    let mut actuators = Vec::new();
+    for (i, a) in case.actuators.iter().enumerate() {
+        let path = format!("actuators[{i}]");
+        v.name(&a.name, &format!("{path}.name"));
+        v.unique(
+            &mut actuator_names,
+            &a.name,
+            format!("{path}.name"),
+            "actuator",
+        );
+        let joint_index = case.joints.iter().position(|j| j.name == a.joint);
+        match joint_index {
+            None => v.unknown(format!("{path}.joint"), "joint", &a.joint),
+            Some(k)
+                if !matches!(
+                    case.joints[k].kind,
+                    JointKindSpec::Revolute | JointKindSpec::Prismatic
+                ) =>
+            {
+                v.invalid(
+                    format!("{path}.joint"),
+                    format!("actuated joint `{}` must be revolute or prismatic", a.joint),
+                );
+            }
+            Some(_) => {}
+        }
+        let map = actuator_map(&context, &a.coordinate, &format!("{path}.coordinate"));
+        let map = match map {
+            Ok(m) => Some(m),
+            Err(e) => {
+                v.push(e);
+                None
+            }
+        };
+        v.positive(a.ratio, &format!("{path}.ratio"));
+        if let (Some(map), Some(k)) = (map, joint_index) {
+            if let (Some(Some(joint)), Some(poses)) = (joints.get(k), &all_poses)
+                && let Some(problem) = joints::check_actuator_follows_joint(
+                    &map,
+                    joint,
+                    poses,
+                    &coordinates,
+                    &samples,
+                    ACTUATOR_TOLERANCE,
+                )
+            {
+                v.invalid(
+                    format!("{path}.coordinate"),
+                    format!(
+                        "u = {} does not follow its joint: {problem}",
+                        a.coordinate.source()
+                    ),
+                );
+            }
+            actuators.push(Actuator {
+                name: a.name.clone(),
+                joint: k,
+                coordinate: map,
+                source: a.coordinate.source(),
+                ratio: a.ratio,
+            });
+        }
+    }
+    if case.actuators.len() != case.coordinates.len() {
+        v.invalid(
+            "actuators",
+            format!(
+                "{} actuators for {} coordinates: the actuator Jacobian must be square (one actuator per coordinate)",
+                case.actuators.len(),
+                case.coordinates.len()
+            ),
+        );
+    }
+    let actuator_index =
+        |name: &str| -> Option<usize> { case.actuators.iter().position(|a| a.name == name) };
+
+    let balancing = case
+        .balancing
+        .as_ref()
+        .and_then(|b| balancing(&mut v, b, &case, &actuator_index));
+    let tasks = case
+        .tasks
+        .as_ref()
+        .and_then(|t| tasks(&mut v, t, &case, &actuator_index));
+    let paths = task_paths(&mut v, &case, &parser, &body_id);
+
+    if !v.errors.is_empty() {
+        return Err(CaseErrors { errors: v.errors });
+    }
+    let bodies = case
+        .bodies
+        .iter()
+        .zip(world)
+        .zip(inertial)
+        .zip(parents)
+        .map(|(((b, pose), (com, inertia)), parent)| {
+            let pose = pose.expect("validated");
+            Body {
+                name: b.name.clone(),
+                parent: parent.expect("validated"),
+                mass: b.mass,
+                com: com.expect("validated"),
+                inertia_com: inertia.expect("validated"),
+                rotation: pose.rotation,
+                origin: pose.origin,
+            }
+        })
+        .collect();
+    Ok(Model {
+        name: case.name.clone(),
+        description: case.description.clone(),
+        gravity: Vector3::from(case.gravity),
+        parameters: case.parameters.0.clone(),
+        coordinates,
+        bodies,
+        payloads,
+        joints: joints.into_iter().map(|j| j.expect("validated")).collect(),
+        actuators,
+        balancing,
+        tasks,
+        paths: paths.expect("validated"),
+        case,
+    })
+}
+
+/// Reports every cycle of the parent relation once (at its first body in file order) and
+/// returns which bodies lie on or hang from a cycle (they have no world pose).
+fn find_cycles(v: &mut Validator, case: &Case, parents: &[Option<BodyId>]) -> Vec<bool> {
+    #[derive(Clone, Copy, PartialEq)]
+    enum State {
+        New,
+        Active,
+        Done(bool),
+    }
+    let n = parents.len();
+    let mut state = vec![State::New; n];
+    for start in 0..n {
+        let mut chain = Vec::new();
+        let mut current = start;
+        let broken = loop {
+            match state[current] {
+                State::Done(b) => break b,
+                State::Active => {
+                    let at = chain.iter().position(|&c| c == current).unwrap_or(0);
+                    let cycle = &chain[at..];
+                    let first = *cycle.iter().min().unwrap_or(&current);
+                    let mut names: Vec<&str> = cycle
+                        .iter()
+                        .map(|&c| case.bodies[c].name.as_str())
+                        .collect();
+                    names.push(&case.bodies[current].name);
+                    v.push(ModelError::Cycle {
+                        path: format!("bodies[{first}].parent"),
+                        cycle: names.join(" → "),
+                    });
+                    break true;
+                }
+                State::New => {
+                    state[current] = State::Active;
+                    chain.push(current);
+                    match parents[current] {
+                        Some(BodyId::Body(p)) => current = p,
+                        Some(BodyId::Base) | None => break false,
+                    }
+                }
+            }
+        };
+        for c in chain {
+            state[c] = State::Done(broken);
+        }
+    }
+    state.into_iter().map(|s| s == State::Done(true)).collect()
+}
+
+/// World poses `parent world · relative`, or `None` where a pose step, a parent, or a cycle
+/// prevents it.
+fn world_poses(
+    parents: &[Option<BodyId>],
+    relative: &[Option<PolyPose>],
+    on_cycle: &[bool],
+) -> Vec<Option<PolyPose>> {
+    fn resolve(
+        i: usize,
+        parents: &[Option<BodyId>],
+        relative: &[Option<PolyPose>],
+        on_cycle: &[bool],
+        memo: &mut Vec<Option<Option<PolyPose>>>,
+    ) -> Option<PolyPose> {
+        if let Some(done) = &memo[i] {
+            return done.clone();
+        }
+        let pose = if on_cycle[i] {
+            None
+        } else {
+            let parent = match parents[i] {
+                None => None,
+                Some(BodyId::Base) => Some(PolyPose::identity()),
+                Some(BodyId::Body(p)) => resolve(p, parents, relative, on_cycle, memo),
+            };
+            parent.zip(relative[i].as_ref()).map(|(parent, rel)| {
+                let mut pose = parent.compose(rel);
+                pose.prune();
+                pose
+            })
+        };
+        memo[i] = Some(pose.clone());
+        pose
+    }
+    let mut memo = vec![None; parents.len()];
+    (0..parents.len())
+        .map(|i| resolve(i, parents, relative, on_cycle, &mut memo))
+        .collect()
+}
+
+/// The length scale of joint tolerances: the largest distance of a body origin from the base
+/// origin at the reference configuration, or of a joint point from its first body's origin.
+fn characteristic_length(
+    case: &Case,
+    coordinates: &[Coordinate],
+    world: &[Option<PolyPose>],
+    parser: &Parser,
+    coordinates_ok: bool,
+) -> f64 {
+    let mut length: f64 = 0.0;
+    if coordinates_ok {
+        let q: Vec<f64> = coordinates.iter().map(Coordinate::midpoint).collect();
+        let kinds: Vec<VarKind> = coordinates.iter().map(|c| c.kind).collect();
+        let at = Point::new(&q, &kinds);
+        for pose in world.iter().flatten() {
+            length = length.max(Vector3::from(pose.origin.eval(&at)).norm());
+        }
+    }
+    for j in &case.joints {
+        if let Some(point) = &j.point {
+            let mut ignored = Vec::new();
+            if let Some(p) = parser.constant_vec(point, "", &mut ignored) {
+                length = length.max(Vector3::from(p).norm());
+            }
+        }
+    }
+    if length.is_finite() { length } else { 0.0 }
+}
+
+/// Resolves a body that carries something (a payload): the base cannot.
+fn carried_body(
+    v: &mut Validator,
+    body_id: &dyn Fn(&str) -> Option<BodyId>,
+    name: &str,
+    path: &str,
+) -> Option<usize> {
+    match body_id(name) {
+        None => {
+            v.unknown(path, "body", name);
+            None
+        }
+        Some(BodyId::Base) => {
+            v.invalid(
+                path,
+                "a payload must be carried by a moving body, not the base",
+            );
+            None
+        }
+        Some(BodyId::Body(i)) => Some(i),
+    }
+}
+
+/// Checks a joint's fields and returns its geometry in the first body's frame.
+fn joint(
+    v: &mut Validator,
+    parser: &Parser,
+    body_id: &dyn Fn(&str) -> Option<BodyId>,
+    j: &crate::case::JointSpec,
+    path: &str,
+) -> Option<JointInput> {
+    let kind = match j.kind {
+        JointKindSpec::Revolute => JointKind::Revolute,
+        JointKindSpec::Prismatic => JointKind::Prismatic,
+        JointKindSpec::Spherical => JointKind::Spherical,
+        JointKindSpec::Universal => JointKind::Universal,
+        JointKindSpec::Fixed => JointKind::Fixed,
+        JointKindSpec::Orientation => JointKind::Orientation,
+    };
+    let mut ok = true;
+    let mut bodies = [BodyId::Base; 2];
+    for (k, name) in j.bodies.iter().enumerate() {
+        match body_id(name) {
+            Some(id) => bodies[k] = id,
+            None => {
+                v.unknown(format!("{path}.bodies[{k}]"), "body", name);
+                ok = false;
+            }
+        }
+    }
+    if ok && bodies[0] == bodies[1] {
+        v.invalid(
+            format!("{path}.bodies"),
+            "a joint must connect two different bodies",
+        );
+        ok = false;
+    }
+    let point = match &j.point {
+        Some(e) => parser.constant_vec(e, &format!("{path}.point"), &mut v.errors),
+        None if kind == JointKind::Orientation => Some([0.0; 3]),
+        None => {
+            v.invalid(
+                format!("{path}.point"),
+                format!("required for a {} joint", kind.name()),
+            );
+            None
+        }
+    };
+    let axis = match (&j.axis, kind.has_axis()) {
+        (Some(e), true) => v.axis(parser, e, &format!("{path}.axis")),
+        (None, true) => {
+            v.invalid(
+                format!("{path}.axis"),
+                format!("required for a {} joint", kind.name()),
+            );
+            None
+        }
+        (Some(_), false) => {
+            v.invalid(
+                format!("{path}.axis"),
+                format!("a {} joint has no axis", kind.name()),
+            );
+            None
+        }
+        (None, false) => None,
+    };
+    let axis2 = match (&j.axis2, kind == JointKind::Universal) {
+        (Some(e), true) => v.axis(parser, e, &format!("{path}.axis2")),
+        (None, true) => {
+            v.invalid(format!("{path}.axis2"), "required for a universal joint");
+            None
+        }
+        (Some(_), false) => {
+            v.invalid(format!("{path}.axis2"), "only a universal joint has axis2");
+            None
+        }
+        (None, false) => None,
+    };
+    let axis_ok = !kind.has_axis() || axis.is_some();
+    let axis2_ok = kind != JointKind::Universal || axis2.is_some();
+    (ok && axis_ok && axis2_ok).then_some(())?;
+    Some(JointInput {
+        name: j.name.clone(),
+        path: path.to_string(),
+        kind,
+        bodies,
+        point: Vector3::from(point?),
+        axis,
+        axis2,
+    })
+}
+
+/// An actuated coordinate: a trigonometric polynomial, or else an angle expression (an integer
+/// combination of angle coordinates plus a constant, e.g. `th1`).
+fn actuator_map(context: &ExprContext, expr: &Expr, path: &str) -> Result<ActuatorMap, ModelError> {
+    let src = match expr {
+        Expr::Number(_) => {
+            return Err(ModelError::invalid(
+                path,
+                "an actuated coordinate must depend on the coordinates",
+            ));
+        }
+        Expr::Text(s) => s,
+    };
+    let map = match context.parse_poly(src) {
+        Ok(poly) => ActuatorMap {
+            linear: Vec::new(),
+            poly,
+        },
+        Err(poly_error) => match context.parse_angle(src) {
+            Ok(angle) => ActuatorMap {
+                linear: angle
+                    .terms
+                    .iter()
+                    .map(|&(k, n)| (k, f64::from(n)))
+                    .collect(),
+                poly: TrigPoly::constant(angle.offset),
+            },
+            Err(_) => {
+                return Err(ModelError::Expression {
+                    path: path.to_string(),
+                    source: poly_error,
+                });
+            }
+        },
+    };
+    if map.poly.terms().any(|(_, c)| !c.is_finite()) {
+        return Err(ModelError::invalid(path, "expression is not finite"));
+    }
+    if map.linear.is_empty() && map.poly.is_constant() {
+        return Err(ModelError::invalid(
+            path,
+            "an actuated coordinate must depend on the coordinates",
+        ));
+    }
+    Ok(map)
+}
+
+/// Resolves a body selection to ascending body indices.
+fn selection(
+    v: &mut Validator,
+    case: &Case,
+    selection: &Selection,
+    path: &str,
+    base_hint: &str,
+) -> Option<Vec<usize>> {
+    match selection {
+        Selection::All => Some((0..case.bodies.len()).collect()),
+        Selection::Names(names) => {
+            let mut out = Vec::new();
+            let mut ok = true;
+            let mut seen = HashMap::new();
+            for (k, name) in names.iter().enumerate() {
+                let item = format!("{path}[{k}]");
+                if name == "base" {
+                    v.invalid(&item, base_hint);
+                    ok = false;
+                } else if let Some(i) = case.bodies.iter().position(|b| b.name == *name) {
+                    if v.unique(&mut seen, name, item, "body") {
+                        out.push(i);
+                    }
+                } else {
+                    v.unknown(item, "body", name);
+                    ok = false;
+                }
+            }
+            out.sort_unstable();
+            ok.then_some(out)
+        }
+    }
+}
+
+fn plane(p: Option<PlaneSpec>) -> Option<Plane> {
+    p.map(|p| match p {
+        PlaneSpec::Xy => Plane::Xy,
+        PlaneSpec::Yz => Plane::Yz,
+        PlaneSpec::Xz => Plane::Xz,
+    })
+}
+
+fn balancing(
+    v: &mut Validator,
+    b: &BalancingSpec,
+    case: &Case,
+    actuator_index: &dyn Fn(&str) -> Option<usize>,
+) -> Option<Balancing> {
+    let start = v.errors.len();
+    if b.dmax < 1 {
+        v.invalid("balancing.dmax", "must be an integer ≥ 1");
+    }
+    let counterweights = b.counterweights.as_ref().and_then(|c| {
+        let bodies = selection(
+            v,
+            case,
+            &c.bodies,
+            "balancing.counterweights.bodies",
+            "the base cannot carry a counterweight",
+        );
+        let shape = c.shape.as_ref().map(|ShapeSpec::Cylinder(cyl)| {
+            v.positive(
+                cyl.radius_to_thickness,
+                "balancing.counterweights.shape.cylinder.radius_to_thickness",
+            );
+            v.positive(
+                cyl.density,
+                "balancing.counterweights.shape.cylinder.density",
+            );
+            CounterweightShape::Cylinder {
+                radius_to_thickness: cyl.radius_to_thickness,
+                density: cyl.density,
+            }
+        });
+        Some(CounterweightOptions {
+            bodies: bodies?,
+            plane: plane(c.plane),
+            shape,
+        })
+    });
+    let springs = b.springs.as_ref().and_then(|s| {
+        let bodies = selection(
+            v,
+            case,
+            &s.bodies,
+            "balancing.springs.bodies",
+            "list moving bodies only; set include_base for springs to the base",
+        );
+        Some(SpringOptions {
+            bodies: bodies?,
+            include_base: s.include_base,
+            plane: plane(s.plane),
+        })
+    });
+    let defaults = Bounds::default();
+    let spec = b.bounds.clone().unwrap_or_default();
+    let mut bound = |value: Option<[f64; 2]>, default: [f64; 2], name: &str| match value {
+        Some(x) => v
+            .interval(x, &format!("balancing.bounds.{name}"))
+            .unwrap_or(default),
+        None => default,
+    };
+    let bounds = Bounds {
+        mass: bound(spec.mass, defaults.mass, "mass"),
+        radius: bound(spec.radius, defaults.radius, "radius"),
+        stiffness: bound(spec.stiffness, defaults.stiffness, "stiffness"),
+        anchor_a: bound(spec.anchor_a, defaults.anchor_a, "anchor_a"),
+        anchor_b: bound(spec.anchor_b, defaults.anchor_b, "anchor_b"),
+    };
+    let mut peak_limits = vec![None; case.actuators.len()];
+    for (name, &limit) in b.peak_limits.iter() {
+        let path = format!("balancing.peak_limits.{name}");
+        match actuator_index(name) {
+            None => v.unknown(&path, "actuator", name),
+            Some(k) => {
+                if v.positive(limit, &path) {
+                    peak_limits[k] = Some(limit);
+                }
+            }
+        }
+    }
+    (v.errors.len() == start).then(|| Balancing {
+        dmax: b.dmax as usize,
+        counterweights,
+        springs,
+        bounds,
+        peak_limits,
+        overrides: b.overrides.clone(),
+    })
+}
+
+fn tasks(
+    v: &mut Validator,
+    t: &TasksSpec,
+    case: &Case,
+    actuator_index: &dyn Fn(&str) -> Option<usize>,
+) -> Option<Tasks> {
+    let start = v.errors.len();
+    let mut grid: Vec<Option<GridAxis>> = vec![None; case.actuators.len()];
+    for (name, &[from, to, n]) in t.grid.iter() {
+        let path = format!("tasks.grid.{name}");
+        let Some(k) = actuator_index(name) else {
+            v.unknown(&path, "actuator", name);
+            continue;
+        };
+        if !v.finite(&[from, to, n], &path) {
+            continue;
+        }
+        if n < 1.0 || n.fract() != 0.0 {
+            v.invalid(
+                format!("{path}[2]"),
+                format!("the number of values must be an integer ≥ 1 (found {n})"),
+            );
+            continue;
+        }
+        grid[k] = Some(GridAxis {
+            from,
+            to,
+            n: n as usize,
+        });
+    }
+    let missing: Vec<&str> = case
+        .actuators
+        .iter()
+        .zip(&grid)
+        .filter(|(_, g)| g.is_none())
+        .map(|(a, _)| a.name.as_str())
+        .collect();
+    if !missing.is_empty() && v.errors.len() == start {
+        v.invalid(
+            "tasks.grid",
+            format!(
+                "every actuator needs a grid axis; missing: {}",
+                missing.join(", ")
+            ),
+        );
+    }
+    v.positive(t.duration, "tasks.duration");
+    if t.samples < 2 {
+        v.invalid(
+            "tasks.samples",
+            format!("must be ≥ 2 (found {})", t.samples),
+        );
+    }
+    (v.errors.len() == start).then(|| Tasks {
+        grid: grid.into_iter().map(|g| g.expect("checked")).collect(),
+        pairs: match t.pairs {
+            PairsSpec::All => PairMode::All,
+            PairsSpec::Ordered => PairMode::Ordered,
+        },
+        law: match t.law {
+            LawSpec::Quintic => MotionLaw::Quintic,
+        },
+        duration: t.duration,
+        samples: t.samples as usize,
+    })
+}
+
+fn task_paths(
+    v: &mut Validator,
+    case: &Case,
+    parser: &Parser,
+    body_id: &dyn Fn(&str) -> Option<BodyId>,
+) -> Option<Vec<TaskPath>> {
+    let start = v.errors.len();
+    let mut names = HashMap::new();
+    let mut out = Vec::new();
+    for (i, p) in case.paths.iter().enumerate() {
+        let path = format!("paths[{i}]");
+        v.name(&p.name, &format!("{path}.name"));
+        v.unique(&mut names, &p.name, format!("{path}.name"), "path");
+        let mut waypoints = Vec::new();
+        for (name, u) in p.waypoints.iter() {
+            let wp = format!("{path}.waypoints.{name}");
+            if u.len() != case.actuators.len() {
+                v.invalid(
+                    &wp,
+                    format!(
+                        "needs one value per actuator ({}), found {}",
+                        case.actuators.len(),
+                        u.len()
+                    ),
+                );
+            }
+            v.finite(u, &wp);
+            waypoints.push(Waypoint {
+                name: name.to_string(),
+                u: u.clone(),
+            });
+        }
+        let mut sequence = Vec::new();
+        for (k, name) in p.sequence.iter().enumerate() {
+            match waypoints.iter().position(|w| w.name == *name) {
+                Some(w) => sequence.push(w),
+                None => v.unknown(format!("{path}.sequence[{k}]"), "waypoint", name),
+            }
+        }
+        if p.sequence.len() < 2 {
+            v.invalid(format!("{path}.sequence"), "needs at least two waypoints");
+        }
+        if p.durations.len() + 1 != p.sequence.len() {
+            v.invalid(
+                format!("{path}.durations"),
+                format!(
+                    "needs one duration per segment ({}), found {}",
+                    p.sequence.len().saturating_sub(1),
+                    p.durations.len()
+                ),
+            );
+        }
+        for (k, &d) in p.durations.iter().enumerate() {
+            v.positive(d, &format!("{path}.durations[{k}]"));
+        }
+        let payload = p.payload.as_ref().and_then(|pl| {
+            let pp = format!("{path}.payload");
+            let body = carried_body(v, body_id, &pl.body, &format!("{pp}.body"));
+            v.positive(pl.mass, &format!("{pp}.mass"));
+            let com = parser.constant_vec(&pl.com, &format!("{pp}.com"), &mut v.errors);
+            let inertia = v.inertia(&pl.inertia.unwrap_or([0.0; 6]), &format!("{pp}.inertia"));
+            let pick = p.sequence.iter().position(|s| *s == pl.pick_at);
+            if pick.is_none() {
+                v.unknown(
+                    format!("{pp}.pick_at"),
+                    "waypoint of the sequence",
+                    &pl.pick_at,
+                );
+            }
+            let drop = pick.and_then(|k| {
+                let found = p.sequence[k + 1..]
+                    .iter()
+                    .position(|s| *s == pl.drop_at)
+                    .map(|d| d + k + 1);
+                if found.is_none() {
+                    v.invalid(
+                        format!("{pp}.drop_at"),
+                        format!(
+                            "`{}` must occur in the sequence after pick_at `{}`",
+                            pl.drop_at, pl.pick_at
+                        ),
+                    );
+                }
+                found
+            });
+            Some(PathPayload {
+                body: body?,
+                mass: pl.mass,
+                com: Vector3::from(com?),
+                inertia_com: inertia?,
+                pick_at: pick?,
+                drop_at: drop?,
+            })
+        });
+        out.push(TaskPath {
+            name: p.name.clone(),
+            waypoints,
+            sequence,
+            durations: p.durations.clone(),
+            payload,
+        });
+    }
+    (v.errors.len() == start).then_some(out)
+}
