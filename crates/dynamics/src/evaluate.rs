@@ -1,0 +1,320 @@
+//! The `evaluate` command logic: the indicators of the unbalanced mechanism (or of any
+//! parameter vectors) over the task grid, and the time series of one task.
+//!
+//! # Output fields
+//!
+//! [`EvaluationReport`] (JSON):
+//! - `case`: case name; `points`: grid points; `tasks`: tasks in the set; `samples`: samples
+//!   per task (both ends included); `duration`: seconds per task; `pairs`: `"all"` (unordered,
+//!   one direction per pair — the reverse has the same RMS and peaks) or `"ordered"`.
+//! - `evaluated`: tasks that ran; `excluded`: `{count, by_reason: {kind: count}, examples: [{task,
+//!   sample, reason}]}` — tasks whose kinematics failed (unreachable: `not_converged`; singular
+//!   actuator Jacobian: `singular`; another assembly branch: `out_of_range`), left out of every
+//!   indicator.
+//! - `qtr` (N·m, Eq. 1: max over tasks of the sum over actuators of the task's RMS motor
+//!   torque) and `qtr_task` (`[from, to]` grid indices); `qit` (N·m, Eq. 2: max over tasks and
+//!   samples of the sum of |motor torque|) and `qit_task`.
+//! - `actuators[]`: `name`, `crt` (critical RMS task `[from, to]`), `crt_rms` (N·m), `cpt`
+//!   (critical peak task), `cpt_peak` (N·m).
+//! - `joints[]` (when reactions are computed): `name`, `force` (`F_j`, N), `force_task`,
+//!   `moment` (`M_j`, N·m about the joint point), `moment_task`.
+//! - `reactions_minimum_norm`: true when the mechanism is overconstrained and the reactions are
+//!   the minimum-norm solution (then `F_j`, `M_j` are one admissible distribution, not the
+//!   unique one).
+//!
+//! Grid indices count grid points with the first actuator varying slowest, each actuator's
+//! values running from `from` to `to`.
+//!
+//! [`Series`] (JSON, one task): `task` `[from, to]`, `t` (s), `u[k][a]` (actuated coordinates),
+//! `q[k][c]` (chart coordinates), `actuator_force[k][a]` (generalized force along actuated
+//! coordinate `a`, N·m or N, before the ratio), `motor_torque[k][a]` (N·m), `joints[]` with
+//! `name`, `force[k]` (N) and `moment[k]` (N·m) magnitudes.
+
+use std::collections::BTreeMap;
+
+use counterpoise_model::{Model, PairMode};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{DynamicsError, TaskFailure};
+use crate::indicators::{Indicators, TaskStats, reduce};
+use crate::params::ParameterSet;
+use crate::runner::{Evaluator, Workspace};
+use crate::tasks::TaskSet;
+
+/// Options of [`evaluate`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EvaluateOptions {
+    /// Samples per task (default: the case's).
+    pub samples: Option<usize>,
+    /// Compute joint reactions (`F_j`, `M_j`).
+    pub reactions: bool,
+}
+
+impl Default for EvaluateOptions {
+    fn default() -> Self {
+        EvaluateOptions {
+            samples: None,
+            reactions: true,
+        }
+    }
+}
+
+/// Tasks left out of the indicators.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Excluded {
+    pub count: usize,
+    pub by_reason: BTreeMap<String, usize>,
+    /// The first few failures (lowest task index first).
+    pub examples: Vec<TaskFailure>,
+}
+
+/// Most failures listed in [`Excluded::examples`].
+pub const MAX_FAILURE_EXAMPLES: usize = 20;
+
+/// The result of [`evaluate`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EvaluationReport {
+    pub case: String,
+    pub points: usize,
+    pub tasks: usize,
+    pub samples: usize,
+    pub duration: f64,
+    pub pairs: String,
+    pub evaluated: usize,
+    pub excluded: Excluded,
+    pub reactions_minimum_norm: bool,
+    #[serde(flatten)]
+    pub indicators: Indicators,
+}
+
+/// Indicators of many parameter columns over the same tasks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridEvaluation {
+    pub tasks: TaskSet,
+    /// One per column.
+    pub indicators: Vec<Indicators>,
+    /// Per task and column statistics (`None` for an excluded task), task-major.
+    pub stats: Vec<Option<Vec<TaskStats>>>,
+    pub excluded: Excluded,
+    pub reactions_minimum_norm: bool,
+}
+
+fn excluded_from(failures: &[TaskFailure]) -> Excluded {
+    let mut by_reason = BTreeMap::new();
+    for f in failures {
+        *by_reason.entry(f.reason.kind().to_string()).or_insert(0) += 1;
+    }
+    Excluded {
+        count: failures.len(),
+        by_reason,
+        examples: failures
+            .iter()
+            .take(MAX_FAILURE_EXAMPLES)
+            .cloned()
+            .collect(),
+    }
+}
+
+/// Runs every grid task for every column of `params` (in parallel over tasks on the current
+/// rayon pool; results are identical for any thread count).
+pub fn evaluate_grid(
+    model: &Model,
+    params: &ParameterSet,
+    options: &EvaluateOptions,
+) -> Result<GridEvaluation, DynamicsError> {
+    let tasks = TaskSet::new(
+        model.tasks.as_ref().ok_or(DynamicsError::NoTasks)?,
+        options.samples,
+    )?;
+    let ev = Evaluator::new(model)?;
+    let grid_q: Vec<_> = tasks.points.par_iter().map(|u| ev.solve_point(u)).collect();
+    let results: Vec<Result<Vec<TaskStats>, TaskFailure>> = (0..tasks.len())
+        .into_par_iter()
+        .map_init(Workspace::default, |ws, w| {
+            let (i, j) = tasks.pair(w);
+            let mut q = match &grid_q[i] {
+                Ok(q) => q.clone(),
+                Err(reason) => {
+                    return Err(TaskFailure {
+                        task: w,
+                        sample: 0,
+                        reason: reason.clone(),
+                    });
+                }
+            };
+            ev.move_stats(
+                &tasks.points[i],
+                &tasks.points[j],
+                tasks.duration,
+                tasks.samples,
+                &mut q,
+                params,
+                options.reactions,
+                ws,
+            )
+            .map_err(|(sample, reason)| TaskFailure {
+                task: w,
+                sample,
+                reason,
+            })
+        })
+        .collect();
+    let mut failures = Vec::new();
+    let mut stats = Vec::with_capacity(results.len());
+    for r in results {
+        match r {
+            Ok(s) => stats.push(Some(s)),
+            Err(f) => {
+                failures.push(f);
+                stats.push(None);
+            }
+        }
+    }
+    let names = ev.actuator_names();
+    let joints = ev.joint_names();
+    let indicators = (0..params.len())
+        .map(|c| {
+            let per_task: Vec<Option<&TaskStats>> =
+                stats.iter().map(|s| s.as_ref().map(|v| &v[c])).collect();
+            reduce(&per_task, &names, &joints, |w| tasks.pair(w))
+        })
+        .collect();
+    Ok(GridEvaluation {
+        indicators,
+        stats,
+        excluded: excluded_from(&failures),
+        reactions_minimum_norm: options.reactions && ev.reactions.minimum_norm,
+        tasks,
+    })
+}
+
+/// The unbalanced indicators of a model over its task grid.
+pub fn evaluate(
+    model: &Model,
+    options: &EvaluateOptions,
+) -> Result<EvaluationReport, DynamicsError> {
+    let params = ParameterSet::unbalanced(model);
+    let mut grid = evaluate_grid(model, &params, options)?;
+    let tasks = &grid.tasks;
+    Ok(EvaluationReport {
+        case: model.name.clone(),
+        points: tasks.points.len(),
+        tasks: tasks.len(),
+        samples: tasks.samples,
+        duration: tasks.duration,
+        pairs: match tasks.mode {
+            PairMode::All => "all",
+            PairMode::Ordered => "ordered",
+        }
+        .to_string(),
+        evaluated: tasks.len() - grid.excluded.count,
+        excluded: grid.excluded.clone(),
+        reactions_minimum_norm: grid.reactions_minimum_norm,
+        indicators: grid.indicators.swap_remove(0),
+    })
+}
+
+/// Reaction magnitudes of one joint along a task.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JointSeries {
+    pub name: String,
+    pub force: Vec<f64>,
+    pub moment: Vec<f64>,
+}
+
+/// The time series of one task (see the module doc).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Series {
+    pub task: [usize; 2],
+    pub t: Vec<f64>,
+    pub u: Vec<Vec<f64>>,
+    pub q: Vec<Vec<f64>>,
+    pub actuator_force: Vec<Vec<f64>>,
+    pub motor_torque: Vec<Vec<f64>>,
+    pub joints: Vec<JointSeries>,
+    pub reactions_minimum_norm: bool,
+}
+
+/// The series of the move from grid point `i` to grid point `j` of the unbalanced model
+/// (any two distinct points; the direction is as given). `samples` overrides the case's.
+pub fn task_series(
+    model: &Model,
+    i: usize,
+    j: usize,
+    samples: Option<usize>,
+) -> Result<Series, DynamicsError> {
+    task_series_with(model, &ParameterSet::unbalanced(model), 0, i, j, samples)
+}
+
+/// Like [`task_series`] for column `column` of `params`.
+pub fn task_series_with(
+    model: &Model,
+    params: &ParameterSet,
+    column: usize,
+    i: usize,
+    j: usize,
+    samples: Option<usize>,
+) -> Result<Series, DynamicsError> {
+    let spec = model.tasks.as_ref().ok_or(DynamicsError::NoTasks)?;
+    let tasks = TaskSet::new(spec, samples)?;
+    let points = tasks.points.len();
+    if i >= points || j >= points || i == j {
+        return Err(DynamicsError::NoSuchTask { i, j, points });
+    }
+    let ev = Evaluator::new(model)?;
+    let mut q = ev
+        .solve_point(&tasks.points[i])
+        .map_err(DynamicsError::TaskFailed)?;
+    let n = ev.mech.n;
+    let mut series = Series {
+        task: [i, j],
+        t: Vec::new(),
+        u: Vec::new(),
+        q: Vec::new(),
+        actuator_force: Vec::new(),
+        motor_torque: Vec::new(),
+        joints: ev
+            .joint_names()
+            .into_iter()
+            .map(|name| JointSeries {
+                name,
+                force: Vec::new(),
+                moment: Vec::new(),
+            })
+            .collect(),
+        reactions_minimum_norm: ev.reactions.minimum_norm,
+    };
+    let mut ws = Workspace::default();
+    ev.run_move(
+        &tasks.points[i],
+        &tasks.points[j],
+        tasks.duration,
+        tasks.samples,
+        &mut q,
+        params,
+        &[column],
+        true,
+        &mut ws,
+        |_, view| {
+            series.t.push(view.t);
+            series.u.push(view.u.clone());
+            series.q.push(view.q.clone());
+            series
+                .actuator_force
+                .push(view.actuator_force[0][..n].to_vec());
+            series.motor_torque.push(view.motor_torque[0][..n].to_vec());
+            for (js, (f, m)) in series.joints.iter_mut().zip(
+                view.reactions[0]
+                    .force
+                    .iter()
+                    .zip(&view.reactions[0].moment),
+            ) {
+                js.force.push(*f);
+                js.moment.push(*m);
+            }
+        },
+    )
+    .map_err(|(_, reason)| DynamicsError::TaskFailed(reason))?;
+    Ok(series)
+}

@@ -1,0 +1,30 @@
+//! Inverse dynamics of counterpoise mechanisms over task grids: motor torques, joint
+//! reactions and the paper's indicators QTR, QIT, F_j, M_j (Martini et al. 2019, Eqs. 1–4).
+//!
+//! Everything is linear in lifted inertial parameters ([`params`]): the kinematics and the
+//! regressor of a sample are computed once and shared by every parameter vector evaluated
+//! with it ([`runner`]). Entry points: [`evaluate`] (the `evaluate` command),
+//! [`task_series`] (one task's time series), [`evaluate_grid`] (many parameter vectors).
+
+pub mod compiled;
+pub mod error;
+pub mod evaluate;
+pub mod indicators;
+pub mod law;
+pub mod lu;
+pub mod mechanism;
+pub mod params;
+pub mod reactions;
+pub mod regressor;
+pub mod runner;
+pub mod tasks;
+
+pub use error::{DynamicsError, FailureReason, TaskFailure};
+pub use evaluate::{
+    EvaluateOptions, EvaluationReport, Excluded, GridEvaluation, JointSeries, Series, evaluate,
+    evaluate_grid, task_series, task_series_with,
+};
+pub use indicators::{ActuatorIndicators, Indicators, JointIndicators, TaskStats};
+pub use params::{Counterweight, ParameterSet, Spring, SpringSlot, Variant};
+pub use runner::Evaluator;
+pub use tasks::TaskSet;

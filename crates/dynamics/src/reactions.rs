@@ -1,0 +1,420 @@
+//! Joint reactions: Newton–Euler per body with the joint constraint wrenches as unknowns.
+//!
+//! Each joint transmits a wrench from its first body to its second, at the joint point, with
+//! the components the joint can carry (world axes, `e` the joint axis, `e₁ ⊥ e₂ ⊥ e`):
+//!
+//! | kind | force unknowns | moment unknowns |
+//! |---|---|---|
+//! | revolute | x, y, z | e₁, e₂ |
+//! | prismatic | e₁, e₂ | x, y, z |
+//! | spherical | x, y, z | – |
+//! | universal | x, y, z | e × e' (e' the second axis) |
+//! | fixed | x, y, z | x, y, z |
+//! | orientation | – | x, y, z |
+//!
+//! For every body `Σ constraint wrenches = inertial wrench − applied wrenches` (applied:
+//! springs and actuators), six equations per body (moments about the body frame origin):
+//! `A(q) λ = b`. An actuator acts along its joint's axis — a torque about a revolute axis, a
+//! force along a prismatic axis — equal and opposite on the joint's two bodies; its size is the
+//! actuator force `Q_u` divided by `κ`, the joint displacement per unit actuated coordinate.
+//!
+//! Mechanisms with loops that are planar in space (the palletizer's pantograph) are
+//! overconstrained: `A` has more columns than rank and the reactions are not unique. We report
+//! the minimum-norm solution `λ = A⁺ b` (all unknowns in N and N·m; the pseudo-inverse drops
+//! singular values below [`RANK_TOLERANCE`] times the largest) and flag it. The fast path uses
+//! `A⁺ = Aᵀ (AAᵀ + UUᵀ)⁻¹` with `U` an orthonormal basis of the body velocity Jacobian — the
+//! left null space of `A` (constraint wrenches do no work on admissible motions) — checked once
+//! at set-up; otherwise a full SVD per sample.
+
+use counterpoise_model::{BodyId, JointKind, Model};
+use nalgebra::{DMatrix, DVector, Vector3};
+
+use crate::lu::SmallLu;
+use crate::mechanism::{BodyKin, Mechanism, Scratch};
+use crate::params::{BODY_PARAMS, ParameterSet};
+use crate::regressor::{SampleRegressor, spring_wrenches};
+
+/// Relative singular-value threshold of the pseudo-inverse.
+pub const RANK_TOLERANCE: f64 = 1e-10;
+
+#[derive(Clone, Debug)]
+struct JointInfo {
+    kind: JointKind,
+    bodies: [BodyId; 2],
+    points: [Vector3<f64>; 2],
+    axis0: Vector3<f64>,
+    axis2: Option<Vector3<f64>>,
+    offset: usize,
+}
+
+impl JointInfo {
+    fn counts(&self) -> (usize, usize) {
+        match self.kind {
+            JointKind::Revolute => (3, 2),
+            JointKind::Prismatic => (2, 3),
+            JointKind::Spherical => (3, 0),
+            JointKind::Universal => (3, 1),
+            JointKind::Fixed => (3, 3),
+            JointKind::Orientation => (0, 3),
+        }
+    }
+}
+
+/// A joint's geometry at one sample (world axes).
+#[derive(Clone, Debug, Default)]
+pub struct JointFrame {
+    pub point: Vector3<f64>,
+    pub axis: Vector3<f64>,
+    pub forces: Vec<Vector3<f64>>,
+    pub moments: Vec<Vector3<f64>>,
+}
+
+/// Two unit vectors completing `e` to an orthonormal basis (deterministic).
+fn perpendiculars(e: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let helper = if e.x.abs() <= e.y.abs() && e.x.abs() <= e.z.abs() {
+        Vector3::x()
+    } else if e.y.abs() <= e.z.abs() {
+        Vector3::y()
+    } else {
+        Vector3::z()
+    };
+    let e1 = e.cross(&helper).normalize();
+    let e2 = e.cross(&e1);
+    (e1, e2)
+}
+
+/// Reaction magnitudes of one sample for one parameter column, per joint.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ReactionMagnitudes {
+    pub force: Vec<f64>,
+    pub moment: Vec<f64>,
+}
+
+/// Builds and solves the reaction equations.
+#[derive(Clone, Debug)]
+pub struct ReactionSolver {
+    joints: Vec<JointInfo>,
+    unknowns: usize,
+    bodies: usize,
+    /// `(actuator, joint)`.
+    actuated: Vec<(usize, usize)>,
+    /// The solution is a minimum-norm choice (more unknowns than independent equations).
+    pub minimum_norm: bool,
+    /// Rank of `A` at the reference configuration.
+    pub rank: usize,
+    fast: bool,
+}
+
+impl ReactionSolver {
+    pub fn new(model: &Model, mech: &Mechanism) -> ReactionSolver {
+        let mut offset = 0;
+        let joints: Vec<JointInfo> = model
+            .joints
+            .iter()
+            .map(|j| {
+                let mut info = JointInfo {
+                    kind: j.kind,
+                    bodies: j.bodies,
+                    points: j.points,
+                    axis0: j.axes.map(|a| a[0].normalize()).unwrap_or_else(Vector3::z),
+                    axis2: j.axis2.map(|a| a.normalize()),
+                    offset,
+                };
+                let (f, m) = info.counts();
+                offset += f + m;
+                info.offset = offset - f - m;
+                info
+            })
+            .collect();
+        let actuated = model
+            .actuators
+            .iter()
+            .enumerate()
+            .map(|(a, act)| (a, act.joint))
+            .collect();
+        let mut solver = ReactionSolver {
+            joints,
+            unknowns: offset,
+            bodies: model.bodies.len(),
+            actuated,
+            minimum_norm: false,
+            rank: 0,
+            fast: false,
+        };
+        // Rank and null-space check at the reference configuration.
+        let q = model.reference_configuration();
+        let mut scratch = Scratch::default();
+        mech.eval_poses(&q, &mut scratch);
+        let zeros = vec![0.0; mech.n];
+        let kin: Vec<BodyKin> = (0..mech.body_count)
+            .map(|b| mech.body_kin(&scratch.pose, b, &zeros, &zeros))
+            .collect();
+        let frames = solver.frames(mech, &scratch.pose);
+        let a = solver.matrix(&frames, &kin);
+        if a.ncols() > 0 && a.nrows() > 0 {
+            let svd = a.clone().svd(false, false);
+            let smax = svd.singular_values.max();
+            solver.rank = svd
+                .singular_values
+                .iter()
+                .filter(|&&s| s > RANK_TOLERANCE * smax)
+                .count();
+            let u = mobility_basis(&kin, mech.n);
+            let leak = (a.transpose() * &u).amax();
+            solver.fast = u.ncols() == mech.n
+                && solver.rank + mech.n == a.nrows()
+                && leak <= 1e-9 * smax.max(1.0);
+        }
+        solver.minimum_norm = solver.rank < solver.unknowns;
+        solver
+    }
+
+    pub fn joint_count(&self) -> usize {
+        self.joints.len()
+    }
+
+    pub fn unknowns(&self) -> usize {
+        self.unknowns
+    }
+
+    /// Whether the fast normal-equation path is in use (see the module doc).
+    pub fn is_fast(&self) -> bool {
+        self.fast
+    }
+
+    /// Joint geometry at the sample whose poses are in `pose`.
+    pub fn frames(&self, mech: &Mechanism, pose: &[f64]) -> Vec<JointFrame> {
+        self.joints
+            .iter()
+            .map(|j| {
+                let (r0, p0) = mech.pose_of(pose, j.bodies[0]);
+                let (r1, p1) = mech.pose_of(pose, j.bodies[1]);
+                let point = if j.kind == JointKind::Prismatic {
+                    p1 + r1 * j.points[1]
+                } else {
+                    p0 + r0 * j.points[0]
+                };
+                let axis = r0 * j.axis0;
+                let (e1, e2) = perpendiculars(&axis);
+                let xyz = vec![Vector3::x(), Vector3::y(), Vector3::z()];
+                let (forces, moments) = match j.kind {
+                    JointKind::Revolute => (xyz, vec![e1, e2]),
+                    JointKind::Prismatic => (vec![e1, e2], xyz),
+                    JointKind::Spherical => (xyz, vec![]),
+                    JointKind::Universal => {
+                        let second = r1 * j.axis2.unwrap_or(e1);
+                        let normal = axis.cross(&second);
+                        let normal = if normal.norm() > 1e-12 {
+                            normal.normalize()
+                        } else {
+                            e1
+                        };
+                        (xyz, vec![normal])
+                    }
+                    JointKind::Fixed => (xyz.clone(), xyz),
+                    JointKind::Orientation => (vec![], xyz),
+                };
+                JointFrame {
+                    point,
+                    axis,
+                    forces,
+                    moments,
+                }
+            })
+            .collect()
+    }
+
+    /// `A` (`6L × K`): column per unknown, rows `[F; N_o]` per body.
+    pub fn matrix(&self, frames: &[JointFrame], kin: &[BodyKin]) -> DMatrix<f64> {
+        let mut a = DMatrix::zeros(6 * self.bodies, self.unknowns);
+        for (j, f) in self.joints.iter().zip(frames) {
+            let mut col = j.offset;
+            for e in &f.forces {
+                for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
+                    if let BodyId::Body(b) = j.bodies[side] {
+                        let m = (f.point - kin[b].p).cross(e);
+                        for r in 0..3 {
+                            a[(6 * b + r, col)] += sign * e[r];
+                            a[(6 * b + 3 + r, col)] += sign * m[r];
+                        }
+                    }
+                }
+                col += 1;
+            }
+            for e in &f.moments {
+                for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
+                    if let BodyId::Body(b) = j.bodies[side] {
+                        for r in 0..3 {
+                            a[(6 * b + 3 + r, col)] += sign * e[r];
+                        }
+                    }
+                }
+                col += 1;
+            }
+        }
+        a
+    }
+
+    /// Reaction magnitudes for every parameter column at one sample.
+    ///
+    /// `reg` holds the sample's body kinematics and wrench regressors, `lu` the LU of `G`,
+    /// `actuator_forces[p]` the actuator forces `Q_u` of column `p`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve(
+        &self,
+        mech: &Mechanism,
+        pose: &[f64],
+        reg: &SampleRegressor,
+        lu: &SmallLu,
+        params: &ParameterSet,
+        columns: &[usize],
+        actuator_forces: &[[f64; counterpoise_symbolic::MAX_VARS]],
+    ) -> Vec<ReactionMagnitudes> {
+        let kin = &reg.kin;
+        let frames = self.frames(mech, pose);
+        let a = self.matrix(&frames, kin);
+        let rows = 6 * self.bodies;
+        let l = self.bodies;
+        // Joint displacement rate per unit actuated coordinate, per actuator.
+        let kappas: Vec<f64> = self
+            .actuated
+            .iter()
+            .map(|&(act, joint)| {
+                let j = &self.joints[joint];
+                let f = &frames[joint];
+                let mut row = [0.0; counterpoise_symbolic::MAX_VARS];
+                for (k, value) in row.iter_mut().enumerate().take(mech.n) {
+                    let rate = |side: usize| -> Vector3<f64> {
+                        match j.bodies[side] {
+                            BodyId::Base => Vector3::zeros(),
+                            BodyId::Body(b) => {
+                                if j.kind == JointKind::Prismatic {
+                                    kin[b].jv[k] + kin[b].jw[k].cross(&(f.point - kin[b].p))
+                                } else {
+                                    kin[b].jw[k]
+                                }
+                            }
+                        }
+                    };
+                    *value = f.axis.dot(&(rate(1) - rate(0)));
+                }
+                lu.solve_transpose(&mut row);
+                row[act]
+            })
+            .collect();
+        let mut b = DMatrix::zeros(rows, columns.len());
+        for (c, &p) in columns.iter().enumerate() {
+            let col = params.column(p);
+            for (i, w) in reg.wrench.iter().enumerate() {
+                let pi = &col[BODY_PARAMS * i..BODY_PARAMS * (i + 1)];
+                for r in 0..6 {
+                    b[(6 * i + r, c)] = (0..BODY_PARAMS).map(|x| w[r][x] * pi[x]).sum::<f64>();
+                }
+            }
+            for (s, slot) in params.springs.iter().enumerate() {
+                let off = BODY_PARAMS * l + crate::params::SPRING_PARAMS * s;
+                let x = &col[off..off + crate::params::SPRING_PARAMS];
+                let (fi, ni, fs, ns) = spring_wrenches(mech, pose, slot, x);
+                for r in 0..3 {
+                    b[(6 * slot.body + r, c)] -= fi[r];
+                    b[(6 * slot.body + 3 + r, c)] -= ni[r];
+                    if let Some(o) = slot.other {
+                        b[(6 * o + r, c)] -= fs[r];
+                        b[(6 * o + 3 + r, c)] -= ns[r];
+                    }
+                }
+            }
+            for (&(act, joint), &kappa) in self.actuated.iter().zip(&kappas) {
+                let j = &self.joints[joint];
+                let f = &frames[joint];
+                let tau = actuator_forces[c][act] / kappa;
+                for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
+                    if let BodyId::Body(bi) = j.bodies[side] {
+                        let (force, moment) = if j.kind == JointKind::Prismatic {
+                            let force = f.axis * (sign * tau);
+                            (force, (f.point - kin[bi].p).cross(&force))
+                        } else {
+                            (Vector3::zeros(), f.axis * (sign * tau))
+                        };
+                        for r in 0..3 {
+                            b[(6 * bi + r, c)] -= force[r];
+                            b[(6 * bi + 3 + r, c)] -= moment[r];
+                        }
+                    }
+                }
+            }
+        }
+        let lambda = self.min_norm_solve(&a, &b, kin, mech.n);
+        (0..columns.len())
+            .map(|c| {
+                let mut out = ReactionMagnitudes::default();
+                for (j, f) in self.joints.iter().zip(&frames) {
+                    let mut force = Vector3::zeros();
+                    let mut moment = Vector3::zeros();
+                    let mut col = j.offset;
+                    for e in &f.forces {
+                        force += e * lambda[(col, c)];
+                        col += 1;
+                    }
+                    for e in &f.moments {
+                        moment += e * lambda[(col, c)];
+                        col += 1;
+                    }
+                    out.force.push(force.norm());
+                    out.moment.push(moment.norm());
+                }
+                out
+            })
+            .collect()
+    }
+
+    /// `λ = A⁺ b` for every column of `b`.
+    fn min_norm_solve(
+        &self,
+        a: &DMatrix<f64>,
+        b: &DMatrix<f64>,
+        kin: &[BodyKin],
+        n: usize,
+    ) -> DMatrix<f64> {
+        if self.fast {
+            let u = mobility_basis(kin, n);
+            let s = a * a.transpose() + &u * u.transpose();
+            if let Some(chol) = s.cholesky() {
+                return a.transpose() * chol.solve(b);
+            }
+        }
+        let svd = a.clone().svd(true, true);
+        let smax = svd.singular_values.max();
+        svd.solve(b, RANK_TOLERANCE * smax)
+            .unwrap_or_else(|_| DMatrix::zeros(a.ncols(), b.ncols()))
+    }
+}
+
+/// Orthonormal basis of the body velocity Jacobian `[J_v; J_ω]` (`6L × n`), modified
+/// Gram–Schmidt; columns that vanish are dropped.
+fn mobility_basis(kin: &[BodyKin], n: usize) -> DMatrix<f64> {
+    let rows = 6 * kin.len();
+    let mut cols: Vec<DVector<f64>> = Vec::with_capacity(n);
+    for k in 0..n {
+        let mut v = DVector::zeros(rows);
+        for (b, bk) in kin.iter().enumerate() {
+            for r in 0..3 {
+                v[6 * b + r] = bk.jv[k][r];
+                v[6 * b + 3 + r] = bk.jw[k][r];
+            }
+        }
+        let scale = v.norm();
+        for c in &cols {
+            let d = c.dot(&v);
+            v -= c * d;
+        }
+        let norm = v.norm();
+        if norm > 1e-10 * scale.max(1e-300) {
+            cols.push(v / norm);
+        }
+    }
+    if cols.is_empty() {
+        return DMatrix::zeros(rows, 0);
+    }
+    DMatrix::from_columns(&cols)
+}

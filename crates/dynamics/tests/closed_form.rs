@@ -1,0 +1,119 @@
+//! Torques and reactions against hand-derived equations of motion.
+
+mod common;
+
+use common::{assert_close, case, quintic};
+use counterpoise_dynamics::{Counterweight, ParameterSet, Variant, task_series, task_series_with};
+
+const G: f64 = 9.81;
+
+#[test]
+fn pendulum_torque_is_j_thetadd_plus_gravity() {
+    let model = case("pendulum");
+    // grid: 5 points from −1.5 to 1.5; move 0 → 4.
+    let s = task_series(&model, 0, 4, Some(41)).unwrap();
+    let (m, l, izz) = (2.0, 1.0, 0.1667);
+    let j = izz + m * (l / 2.0) * (l / 2.0);
+    for (k, &t) in s.t.iter().enumerate() {
+        let (th, _, thdd) = quintic(-1.5, 1.5, 1.0, t);
+        assert_close(s.q[k][0], th, 1e-10, "theta");
+        let tau = j * thdd + m * G * (l / 2.0) * th.cos();
+        assert_close(
+            s.actuator_force[k][0],
+            tau,
+            1e-9 * (1.0 + tau.abs()),
+            "torque",
+        );
+        assert_close(s.motor_torque[k][0], 0.01 * tau, 1e-11, "motor torque");
+    }
+}
+
+#[test]
+fn pendulum_pivot_force_is_m_times_a_minus_g() {
+    let model = case("pendulum");
+    let s = task_series(&model, 1, 3, Some(31)).unwrap();
+    let (m, c) = (2.0, 0.5);
+    for (k, &t) in s.t.iter().enumerate() {
+        let (th, thd, thdd) = quintic(-0.75, 0.75, 1.0, t);
+        let ax = c * (-thdd * th.sin() - thd * thd * th.cos());
+        let ay = c * (thdd * th.cos() - thd * thd * th.sin());
+        let f = m * ((ax).powi(2) + (ay + G).powi(2)).sqrt();
+        assert_close(s.joints[0].force[k], f, 1e-9 * f, "pivot force");
+        assert!(
+            s.joints[0].moment[k].abs() < 1e-9,
+            "planar: no moment ⊥ axis"
+        );
+    }
+    assert!(!s.reactions_minimum_norm);
+}
+
+#[test]
+fn two_link_torques_match_lagrange() {
+    let model = case("two_link");
+    // Link 2 with its 1 kg tool at L2 (payloads move with their body).
+    let l1 = 0.8;
+    let (m1, h1, j1) = (4.0, 4.0 * 0.4, 0.2133 + 4.0 * 0.16);
+    let (m2, h2, j2) = (
+        2.5 + 1.0,
+        2.5 * 0.3 + 1.0 * 0.6,
+        0.075 + 2.5 * 0.09 + 1.0 * 0.36,
+    );
+    let _ = m1;
+    // grid 3×3: M1 ∈ {−1,0,1}, M2 ∈ {−1.5,0,1.5}; point 0 = (−1,−1.5), point 8 = (1, 1.5)
+    for (i, jdx) in [(0usize, 8usize), (2, 6), (1, 5)] {
+        let s = task_series(&model, i, jdx, Some(25)).unwrap();
+        let grid = |p: usize| [-1.0 + (p / 3) as f64, -1.5 + 1.5 * (p % 3) as f64];
+        let (a, b) = (grid(i), grid(jdx));
+        for (k, &t) in s.t.iter().enumerate() {
+            let (q1, qd1, qdd1) = quintic(a[0], b[0], 1.5, t);
+            let (q2, qd2, qdd2) = quintic(a[1], b[1], 1.5, t);
+            let c2 = q2.cos();
+            let s2 = q2.sin();
+            let m11 = j1 + j2 + m2 * l1 * l1 + 2.0 * h2 * l1 * c2;
+            let m12 = j2 + h2 * l1 * c2;
+            let m22 = j2;
+            let g1 = G * (h1 + m2 * l1) * q1.cos() + G * h2 * (q1 + q2).cos();
+            let g2 = G * h2 * (q1 + q2).cos();
+            let tau1 = m11 * qdd1 + m12 * qdd2 - h2 * l1 * s2 * (2.0 * qd1 * qd2 + qd2 * qd2) + g1;
+            let tau2 = m12 * qdd1 + m22 * qdd2 + h2 * l1 * s2 * qd1 * qd1 + g2;
+            assert_close(
+                s.actuator_force[k][0],
+                tau1,
+                1e-9 * (1.0 + tau1.abs()),
+                "tau1",
+            );
+            assert_close(
+                s.actuator_force[k][1],
+                tau2,
+                1e-9 * (1.0 + tau2.abs()),
+                "tau2",
+            );
+        }
+    }
+}
+
+#[test]
+fn counterweight_balancing_the_pendulum_leaves_no_static_torque() {
+    let model = case("pendulum");
+    // m·r = −m_rod·c: 4 kg at x = −0.25 m.
+    let variant = Variant {
+        counterweights: vec![Counterweight {
+            body: 0,
+            mass: 4.0,
+            position: [-0.25, 0.0, 0.0],
+        }],
+        springs: vec![],
+    };
+    let params = ParameterSet::from_variants(&model, &[Variant::default(), variant]).unwrap();
+    let s = task_series_with(&model, &params, 1, 0, 4, Some(21)).unwrap();
+    let ub = task_series_with(&model, &params, 0, 0, 4, Some(21)).unwrap();
+    // at rest (both ends) the balanced torque vanishes, the unbalanced does not
+    for k in [0, s.t.len() - 1] {
+        assert!(
+            s.actuator_force[k][0].abs() < 1e-10,
+            "{}",
+            s.actuator_force[k][0]
+        );
+        assert!(ub.actuator_force[k][0].abs() > 0.5);
+    }
+}
