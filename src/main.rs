@@ -1,1 +1,81 @@
-fn main() {}
+//! The `counterpoise` command line.
+
+mod commands;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Exact static balancing of mechanisms with counterweights and springs.
+#[derive(Parser, Debug)]
+#[command(name = "counterpoise", version, about, long_about = None)]
+struct Cli {
+    /// Worker threads for parallel stages (default: all cores). Results do not depend on it.
+    #[arg(long, global = true)]
+    jobs: Option<usize>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Validate a case file and print a summary of the mechanism.
+    Check {
+        /// Case file (JSON).
+        case: PathBuf,
+    },
+    /// Find every set of at most Dmax balancing elements that balances the mechanism exactly.
+    Variants {
+        case: PathBuf,
+        /// Most elements per variant (default: the case's `balancing.dmax`).
+        #[arg(long)]
+        dmax: Option<usize>,
+        /// Print the full results as JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+    },
+    /// The whole case study: balance, optimise, rank, report (not yet available).
+    Run {
+        case: PathBuf,
+        #[arg(long)]
+        dmax: Option<usize>,
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if let Some(jobs) = cli.jobs {
+        if jobs == 0 {
+            eprintln!("error: --jobs must be at least 1");
+            return ExitCode::from(2);
+        }
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(jobs)
+            .build_global()
+        {
+            eprintln!("error: cannot start {jobs} worker threads: {e}");
+            return ExitCode::from(2);
+        }
+    }
+    let result = match cli.command {
+        Command::Check { case } => commands::check::run(&case),
+        Command::Variants { case, dmax, json } => commands::variants::run(&case, dmax, json),
+        Command::Run { .. } => {
+            eprintln!(
+                "counterpoise run: not yet available — the optimisation and report stages are \
+                 still being built. `counterpoise variants CASE` runs the balance search."
+            );
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

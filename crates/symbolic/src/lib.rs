@@ -8,6 +8,7 @@
 //! [`PolyVec3`]/[`PolyMat3`] poses, and the case-file expression language in [`expr`].
 
 pub mod angle;
+pub mod display;
 pub mod expr;
 pub mod geometry;
 pub mod monomial;

@@ -1,0 +1,402 @@
+//! Realization: from a lifted solution set to physical parameters (m, r, K, a, b).
+//!
+//! The only nonlinear step of the balance search. Counterweights are easy — `(m, μ) ↦ (m, μ/m)` is
+//! a bijection for `m > 0` — but a spring's lifted variables must satisfy `W = α βᵀ / K` with
+//! `K > 0`. So the search is a small nonlinear least-squares problem in physical variables,
+//! `A_S x(y) = −b` with `y = (ln m, μ; ln K, a, b)`, solved by Levenberg–Marquardt from a few
+//! deterministic starting points. The logarithms keep every mass and stiffness positive.
+//!
+//! The solver either finds a witness (which the caller then verifies by sampling the energy) or
+//! gives up; giving up is reported as `undecided`, never as a proof of impossibility. Proofs come
+//! from the linear stage: a mass or stiffness that is the same in every lifted solution and is
+//! not positive.
+
+use counterpoise_model::sampling::SplitMix64;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use crate::element::{Attachment, CatalogueEntry, Element};
+use crate::linear::LinearSolution;
+
+/// Scales that make starting points and witnesses plausible to a designer.
+#[derive(Clone, Copy, Debug)]
+pub struct RealizationHints {
+    /// Typical counterweight mass (kg).
+    pub mass: f64,
+    /// Typical spring stiffness (N/m).
+    pub stiffness: f64,
+    /// Typical anchor or offset length (m).
+    pub length: f64,
+}
+
+impl Default for RealizationHints {
+    fn default() -> Self {
+        RealizationHints {
+            mass: 50.0,
+            stiffness: 3000.0,
+            length: 0.5,
+        }
+    }
+}
+
+/// Physical parameters of one counterweight.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CounterweightParams {
+    /// Catalogue entry.
+    pub entry: usize,
+    pub body: usize,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Centre of mass in the body frame (m).
+    pub offset: [f64; 3],
+}
+
+/// Physical parameters of one zero-free-length spring.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SpringParams {
+    pub entry: usize,
+    pub body: usize,
+    pub other: Attachment,
+    /// Stiffness (N/m).
+    pub stiffness: f64,
+    /// Anchor on `body`, in its frame (m).
+    pub anchor_a: [f64; 3],
+    /// Anchor on `other`, in its frame (m).
+    pub anchor_b: [f64; 3],
+}
+
+/// A physical parameter set for a variant.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Witness {
+    pub counterweights: Vec<CounterweightParams>,
+    pub springs: Vec<SpringParams>,
+}
+
+/// Outcome of realization.
+#[derive(Clone, Debug)]
+pub enum Realization {
+    Found(Witness),
+    /// Proven impossible, with the reason.
+    Impossible(String),
+    /// The variant really is a smaller one: an element must vanish or is not what it claims.
+    Degenerate(String),
+    /// The local search gave up; the reason says how far it got.
+    GaveUp(String),
+}
+
+/// Layout of physical unknowns for one element of the variant.
+struct Slot<'a> {
+    entry_index: usize,
+    entry: &'a CatalogueEntry,
+    /// First lifted variable (column of `A_S`).
+    column: usize,
+    /// First physical unknown in `y`.
+    unknown: usize,
+}
+
+/// Tries to find physical parameters in the solution set of `solution`.
+pub fn realize(
+    solution: &LinearSolution,
+    b: &DVector<f64>,
+    entries: &[(usize, &CatalogueEntry)],
+    hints: RealizationHints,
+) -> Realization {
+    let b_norm = b.norm();
+    // Proofs from the linear stage first.
+    for (k, (_, entry)) in entries.iter().enumerate() {
+        let range = solution.element_range(k);
+        let head = range.start; // m or K
+        if solution.is_fixed(head) {
+            let value = solution.particular[head];
+            let scaled = value * solution.column_scale[head];
+            let zero = scaled.abs() <= 1e-7 * b_norm.max(1.0);
+            match entry.element {
+                Element::Counterweight { .. } if zero => {
+                    return Realization::Impossible(format!(
+                        "{}: mass must be zero while m·r is not: no counterweight does that",
+                        entry.label
+                    ));
+                }
+                Element::Counterweight { .. } if value < 0.0 => {
+                    return Realization::Impossible(format!(
+                        "{}: mass must be negative ({value:.4} kg)",
+                        entry.label
+                    ));
+                }
+                Element::Spring { .. } if zero => {
+                    return Realization::Degenerate(format!(
+                        "{}: stiffness must be zero while K·a or K·b is not: the element would act \
+                         as a constant force, not a spring",
+                        entry.label
+                    ));
+                }
+                Element::Spring { .. } if value < 0.0 => {
+                    return Realization::Impossible(format!(
+                        "{}: stiffness must be negative ({value:.4} N/m)",
+                        entry.label
+                    ));
+                }
+                _ => {}
+            }
+        }
+    }
+
+    let mut slots = Vec::new();
+    let mut unknowns = 0;
+    for (k, (entry_index, entry)) in entries.iter().enumerate() {
+        slots.push(Slot {
+            entry_index: *entry_index,
+            entry,
+            column: solution.offsets[k],
+            unknown: unknowns,
+        });
+        unknowns += physical_len(&entry.element);
+    }
+    let problem = Problem {
+        matrix: &solution.matrix,
+        b,
+        slots: &slots,
+        unknowns,
+    };
+
+    // Fixed seed: starting points must not depend on thread count or on run.
+    let mut rng = SplitMix64::new(0x5eed_ba1a_2ce0_0001);
+    let mut best = f64::INFINITY;
+    for start in 0..STARTS {
+        let y0 = problem.start(solution, hints, start, &mut rng);
+        let (y, residual) = problem.levenberg_marquardt(y0);
+        best = best.min(residual);
+        if residual <= SOLVED_TOL {
+            return Realization::Found(problem.witness(&y));
+        }
+    }
+    Realization::GaveUp(format!(
+        "no physical parameters found from {STARTS} starts (best relative residual {best:.2e})"
+    ))
+}
+
+const STARTS: usize = 24;
+const MAX_ITERATIONS: usize = 400;
+/// Relative residual ‖A x(y) + b‖/‖b‖ at which the local search stops; the energy sampling of
+/// the caller is the real check.
+const SOLVED_TOL: f64 = 1e-13;
+const LOG_RANGE: (f64, f64) = (-25.0, 30.0);
+
+fn physical_len(element: &Element) -> usize {
+    match element {
+        Element::Counterweight { axes, .. } => 1 + axes.len(),
+        Element::Spring { axes_a, axes_b, .. } => 1 + axes_a.len() + axes_b.len(),
+    }
+}
+
+struct Problem<'a> {
+    matrix: &'a DMatrix<f64>,
+    b: &'a DVector<f64>,
+    slots: &'a [Slot<'a>],
+    unknowns: usize,
+}
+
+impl Problem<'_> {
+    /// Residual `(A x(y) + b)/‖b‖` and its Jacobian.
+    fn evaluate(&self, y: &DVector<f64>) -> (DVector<f64>, DMatrix<f64>) {
+        let scale = 1.0 / self.b.norm().max(f64::MIN_POSITIVE);
+        let rows = self.matrix.nrows();
+        let mut r = self.b * scale;
+        let mut jac = DMatrix::zeros(rows, self.unknowns);
+        for slot in self.slots {
+            let col = |j: usize| self.matrix.column(slot.column + j) * scale;
+            match &slot.entry.element {
+                Element::Counterweight { axes, .. } => {
+                    let m = y[slot.unknown].exp();
+                    let dm = col(0) * m;
+                    r += &dm;
+                    jac.set_column(slot.unknown, &dm);
+                    for k in 0..axes.len() {
+                        let mu = y[slot.unknown + 1 + k];
+                        r += col(1 + k) * mu;
+                        jac.set_column(slot.unknown + 1 + k, &col(1 + k));
+                    }
+                }
+                Element::Spring { axes_a, axes_b, .. } => {
+                    let (na, nb) = (axes_a.len(), axes_b.len());
+                    let stiffness = y[slot.unknown].exp();
+                    let a: Vec<f64> = (0..na).map(|k| y[slot.unknown + 1 + k]).collect();
+                    let bb: Vec<f64> = (0..nb).map(|l| y[slot.unknown + 1 + na + l]).collect();
+                    let w = |k: usize, l: usize| 1 + na + nb + k * nb + l;
+                    // contribution per unit K: φ_K + Σ a_k φ_αk + Σ b_l φ_βl + Σ a_k b_l φ_Wkl
+                    let mut unit = col(0);
+                    for k in 0..na {
+                        unit += col(1 + k) * a[k];
+                    }
+                    for l in 0..nb {
+                        unit += col(1 + na + l) * bb[l];
+                    }
+                    for k in 0..na {
+                        for l in 0..nb {
+                            unit += col(w(k, l)) * (a[k] * bb[l]);
+                        }
+                    }
+                    r += &unit * stiffness;
+                    jac.set_column(slot.unknown, &(&unit * stiffness));
+                    for k in 0..na {
+                        let mut d = col(1 + k);
+                        for l in 0..nb {
+                            d += col(w(k, l)) * bb[l];
+                        }
+                        jac.set_column(slot.unknown + 1 + k, &(d * stiffness));
+                    }
+                    for l in 0..nb {
+                        let mut d = col(1 + na + l);
+                        for k in 0..na {
+                            d += col(w(k, l)) * a[k];
+                        }
+                        jac.set_column(slot.unknown + 1 + na + l, &(d * stiffness));
+                    }
+                }
+            }
+        }
+        (r, jac)
+    }
+
+    /// Starting point `start`: the first follows the lifted particular solution where it is
+    /// physical, the others are spread deterministically around the hints.
+    fn start(
+        &self,
+        solution: &LinearSolution,
+        hints: RealizationHints,
+        start: usize,
+        rng: &mut SplitMix64,
+    ) -> DVector<f64> {
+        let mut y = DVector::zeros(self.unknowns);
+        for slot in self.slots {
+            let x = |j: usize| solution.particular[slot.column + j];
+            match &slot.entry.element {
+                Element::Counterweight { axes, .. } => {
+                    let m = if start == 0 && x(0) > 0.0 {
+                        x(0)
+                    } else {
+                        hints.mass * (rng.uniform(-2.3, 2.3)).exp()
+                    };
+                    y[slot.unknown] = m.ln();
+                    for k in 0..axes.len() {
+                        y[slot.unknown + 1 + k] = if start == 0 {
+                            x(1 + k)
+                        } else {
+                            m * hints.length * rng.uniform(-1.0, 1.0)
+                        };
+                    }
+                }
+                Element::Spring { axes_a, axes_b, .. } => {
+                    let k0 = if start == 0 && x(0) > 0.0 {
+                        x(0)
+                    } else {
+                        hints.stiffness * (rng.uniform(-1.6, 1.6)).exp()
+                    };
+                    y[slot.unknown] = k0.ln();
+                    for j in 0..axes_a.len() + axes_b.len() {
+                        y[slot.unknown + 1 + j] = hints.length * rng.uniform(-1.0, 1.0);
+                    }
+                }
+            }
+        }
+        y
+    }
+
+    /// Damped Gauss–Newton with Marquardt's adaptive damping; returns the point and its relative
+    /// residual.
+    fn levenberg_marquardt(&self, mut y: DVector<f64>) -> (DVector<f64>, f64) {
+        let (mut r, mut jac) = self.evaluate(&y);
+        let mut cost = r.norm();
+        let mut lambda = 1e-3;
+        for _ in 0..MAX_ITERATIONS {
+            if cost <= SOLVED_TOL {
+                break;
+            }
+            let jtj = jac.transpose() * &jac;
+            let gradient = jac.transpose() * &r;
+            let mut improved = false;
+            for _ in 0..12 {
+                let mut damped = jtj.clone();
+                for i in 0..self.unknowns {
+                    damped[(i, i)] += lambda * (jtj[(i, i)] + 1e-9);
+                }
+                let Some(chol) = damped.cholesky() else {
+                    lambda *= 10.0;
+                    continue;
+                };
+                let step = chol.solve(&(-&gradient));
+                let mut candidate = &y + &step;
+                self.clamp_logs(&mut candidate);
+                let (r_new, jac_new) = self.evaluate(&candidate);
+                let cost_new = r_new.norm();
+                if cost_new.is_finite() && cost_new < cost {
+                    y = candidate;
+                    r = r_new;
+                    jac = jac_new;
+                    let relative_gain = (cost - cost_new) / cost;
+                    cost = cost_new;
+                    lambda = (lambda / 3.0).max(1e-15);
+                    improved = relative_gain > 1e-15;
+                    break;
+                }
+                lambda *= 4.0;
+            }
+            if !improved {
+                break;
+            }
+        }
+        (y, cost)
+    }
+
+    fn clamp_logs(&self, y: &mut DVector<f64>) {
+        for slot in self.slots {
+            let v = &mut y[slot.unknown];
+            *v = v.clamp(LOG_RANGE.0, LOG_RANGE.1);
+        }
+    }
+
+    fn witness(&self, y: &DVector<f64>) -> Witness {
+        let mut witness = Witness::default();
+        for slot in self.slots {
+            match &slot.entry.element {
+                Element::Counterweight { body, axes } => {
+                    let mass = y[slot.unknown].exp();
+                    let mut offset = [0.0; 3];
+                    for (k, &axis) in axes.iter().enumerate() {
+                        offset[axis] = y[slot.unknown + 1 + k] / mass;
+                    }
+                    witness.counterweights.push(CounterweightParams {
+                        entry: slot.entry_index,
+                        body: *body,
+                        mass,
+                        offset,
+                    });
+                }
+                Element::Spring {
+                    body,
+                    other,
+                    axes_a,
+                    axes_b,
+                } => {
+                    let mut anchor_a = [0.0; 3];
+                    let mut anchor_b = [0.0; 3];
+                    for (k, &axis) in axes_a.iter().enumerate() {
+                        anchor_a[axis] = y[slot.unknown + 1 + k];
+                    }
+                    for (l, &axis) in axes_b.iter().enumerate() {
+                        anchor_b[axis] = y[slot.unknown + 1 + axes_a.len() + l];
+                    }
+                    witness.springs.push(SpringParams {
+                        entry: slot.entry_index,
+                        body: *body,
+                        other: *other,
+                        stiffness: y[slot.unknown].exp(),
+                        anchor_a,
+                        anchor_b,
+                    });
+                }
+            }
+        }
+        witness
+    }
+}

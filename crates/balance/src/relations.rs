@@ -1,0 +1,156 @@
+//! Balance relations in readable form: what balance imposes on the lifted parameters, and the
+//! freedom it leaves (like the paper's symbolic `solve` output, e.g. `m4·r4x = −68.59 kg·m`).
+
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use crate::element::{CatalogueEntry, Element};
+use crate::linear::{FIXED_TOL, LinearSolution};
+
+/// One free direction of the balanced family: moving along it keeps the energy constant.
+#[derive(Clone, Debug, Serialize)]
+pub struct FreeDirection {
+    /// Lifted variable → component (largest component scaled to ±1; negligible ones omitted).
+    pub components: Vec<(String, f64)>,
+    /// For a one-dimensional family `x_p + t·n`: the interval of `t` over which every installed
+    /// mass and stiffness stays positive (`None` = unbounded on that side). Lifted positivity only;
+    /// spring realizability is checked on the witness.
+    pub positive_interval: Option<(Option<f64>, Option<f64>)>,
+}
+
+/// Unit of each lifted variable of an element, in the order of its variables.
+pub fn variable_units(entry: &CatalogueEntry) -> Vec<&'static str> {
+    match &entry.element {
+        Element::Counterweight { axes, .. } => std::iter::once("kg")
+            .chain(axes.iter().map(|_| "kg·m"))
+            .collect(),
+        Element::Spring { axes_a, axes_b, .. } => std::iter::once("N/m")
+            .chain(axes_a.iter().map(|_| "N"))
+            .chain(axes_b.iter().map(|_| "N"))
+            .chain(std::iter::repeat_n("N·m", axes_a.len() * axes_b.len()))
+            .collect(),
+    }
+}
+
+fn format_number(x: f64) -> String {
+    let s = format!("{x:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+/// Reduced row-echelon form of `[A | −b]` in the variant's lifted variables, written as equations.
+///
+/// Gauss–Jordan with the pivot taken in variable order (so each relation is solved for the
+/// earliest variable it involves), rows and columns scaled first so that the tolerance is
+/// relative.
+pub fn balance_relations(
+    solution: &LinearSolution,
+    b: &DVector<f64>,
+    names: &[String],
+    units: &[&str],
+) -> Vec<String> {
+    let (rows, cols) = solution.matrix.shape();
+    let mut m = DMatrix::zeros(rows, cols + 1);
+    for j in 0..cols {
+        m.set_column(j, &(solution.matrix.column(j) / solution.column_scale[j]));
+    }
+    m.set_column(cols, &(-b));
+    let tol = 1e-9 * m.amax().max(f64::MIN_POSITIVE);
+    let mut pivot_row = 0;
+    let mut pivots = Vec::new();
+    for j in 0..cols {
+        if pivot_row == rows {
+            break;
+        }
+        let (best, value) = (pivot_row..rows)
+            .map(|i| (i, m[(i, j)].abs()))
+            .fold((pivot_row, 0.0), |acc, x| if x.1 > acc.1 { x } else { acc });
+        if value <= tol {
+            continue;
+        }
+        m.swap_rows(pivot_row, best);
+        let p = m[(pivot_row, j)];
+        m.row_mut(pivot_row).scale_mut(1.0 / p);
+        for i in 0..rows {
+            if i != pivot_row {
+                let f = m[(i, j)];
+                if f != 0.0 {
+                    for c in 0..=cols {
+                        let v = m[(pivot_row, c)];
+                        m[(i, c)] -= f * v;
+                    }
+                }
+            }
+        }
+        pivots.push((pivot_row, j));
+        pivot_row += 1;
+    }
+    let mut relations = Vec::new();
+    for (row, pivot) in pivots {
+        // Undo column scaling: y_j = s_j x_j, so x_pivot + Σ c_j (s_j/s_p) x_j = rhs / s_p.
+        let s_p = solution.column_scale[pivot];
+        let mut lhs = names[pivot].clone();
+        for j in (pivot + 1)..cols {
+            let c = m[(row, j)] * solution.column_scale[j] / s_p;
+            if m[(row, j)].abs() > 1e-9 {
+                let sign = if c < 0.0 { "−" } else { "+" };
+                lhs.push_str(&format!(" {sign} {}·{}", format_number(c.abs()), names[j]));
+            }
+        }
+        let rhs = m[(row, cols)] / s_p;
+        relations.push(format!("{lhs} = {} {}", format_number(rhs), units[pivot]));
+    }
+    relations
+}
+
+/// The free directions of the solution set, with the positivity interval for a 1-D family.
+pub fn free_directions(
+    solution: &LinearSolution,
+    names: &[String],
+    positive_variables: &[usize],
+) -> Vec<FreeDirection> {
+    let n = &solution.nullspace;
+    let one_dimensional = n.ncols() == 1;
+    (0..n.ncols())
+        .map(|k| {
+            let column = n.column(k);
+            let scaled: Vec<f64> = (0..column.len())
+                .map(|j| column[j] * solution.column_scale[j])
+                .collect();
+            let biggest = scaled.iter().enumerate().fold((0, 0.0f64), |acc, (j, v)| {
+                if v.abs() > acc.1 { (j, v.abs()) } else { acc }
+            });
+            let norm = column[biggest.0];
+            let components = (0..column.len())
+                .filter(|&j| scaled[j].abs() > FIXED_TOL * biggest.1.max(f64::MIN_POSITIVE) * 1e3)
+                .map(|j| (names[j].clone(), column[j] / norm))
+                .collect();
+            let positive_interval = one_dimensional.then(|| {
+                let mut lo: Option<f64> = None;
+                let mut hi: Option<f64> = None;
+                for &j in positive_variables {
+                    // x_p[j] + t·n[j]/norm > 0
+                    let slope = column[j] / norm;
+                    if (column[j] * solution.column_scale[j]).abs() <= FIXED_TOL {
+                        continue;
+                    }
+                    let bound = -solution.particular[j] / slope;
+                    if slope > 0.0 {
+                        lo = Some(lo.map_or(bound, |l: f64| l.max(bound)));
+                    } else {
+                        hi = Some(hi.map_or(bound, |h: f64| h.min(bound)));
+                    }
+                }
+                (lo, hi)
+            });
+            FreeDirection {
+                components,
+                positive_interval,
+            }
+        })
+        .collect()
+}

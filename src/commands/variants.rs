@@ -1,0 +1,225 @@
+//! `counterpoise variants CASE`: the exact balance search and its results.
+
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use counterpoise_balance::{
+    Attachment, Catalogue, Class, SearchOptions, SearchReport, Status, VariantResult,
+    catalogue_options, mechanism_energy, realization_hints, search,
+};
+use counterpoise_model::Model;
+use serde_json::json;
+
+/// Version of the `variants --json` schema (documented in README.md).
+pub const SCHEMA_VERSION: u32 = 1;
+
+pub fn run(path: &Path, dmax: Option<usize>, as_json: bool) -> Result<ExitCode> {
+    let Some(model) = super::load(path)? else {
+        return Ok(ExitCode::FAILURE);
+    };
+    let Some(balancing) = &model.balancing else {
+        bail!("{}: the case has no `balancing` section", path.display());
+    };
+    let dmax = dmax.unwrap_or(balancing.dmax);
+    if dmax == 0 {
+        bail!("--dmax must be at least 1");
+    }
+    let started = Instant::now();
+    let energy = mechanism_energy(&model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+    if catalogue.is_empty() {
+        bail!(
+            "{}: `balancing` allows no counterweight and no spring",
+            path.display()
+        );
+    }
+    let report = search(
+        &energy,
+        catalogue,
+        SearchOptions {
+            dmax,
+            hints: realization_hints(&model),
+        },
+    );
+    let elapsed = started.elapsed().as_secs_f64();
+    if as_json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&to_json(&model, dmax, &report, elapsed))?
+        );
+    } else {
+        print!("{}", tables(&model, dmax, &report, elapsed));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The `--json` document.
+pub fn to_json(
+    model: &Model,
+    dmax: usize,
+    report: &SearchReport,
+    seconds: f64,
+) -> serde_json::Value {
+    let catalogue: Vec<_> = report
+        .catalogue
+        .entries
+        .iter()
+        .map(
+            |e| json!({ "label": e.label, "description": e.description, "variables": e.variables }),
+        )
+        .collect();
+    let mut counts = serde_json::Map::new();
+    for status in Status::ALL {
+        counts.insert(status.name().into(), json!(report.count(status)));
+    }
+    json!({
+        "schema_version": SCHEMA_VERSION,
+        "case": model.name,
+        "dmax": dmax,
+        "seconds": seconds,
+        "catalogue": catalogue,
+        "counts": counts,
+        "variants": report.variants,
+    })
+}
+
+fn angle(u: f64, v: f64) -> f64 {
+    let a = v.atan2(u);
+    if a < -1e-12 {
+        a + std::f64::consts::TAU
+    } else {
+        a.max(0.0)
+    }
+}
+
+fn polar(v: [f64; 3]) -> (f64, f64) {
+    // magnitude and angle in the plane of the two largest components' axes (the element's plane
+    // when the case restricts it; x–y otherwise)
+    let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let (u, w) = if v[2].abs() <= 1e-15 {
+        (v[0], v[1])
+    } else if v[0].abs() <= 1e-15 {
+        (v[1], v[2])
+    } else {
+        (v[0], v[2])
+    };
+    (norm, angle(u, w))
+}
+
+/// Witness parameters in the units of the paper's Table 1: kg, mm, N/mm, rad.
+pub fn witness_lines(model: &Model, v: &VariantResult) -> Vec<String> {
+    let Some(w) = &v.witness else {
+        return Vec::new();
+    };
+    let mut lines = Vec::new();
+    let label = |entry: usize| {
+        v.elements
+            .iter()
+            .find(|e| e.entry == entry)
+            .map_or("?", |e| e.label.as_str())
+    };
+    for cw in &w.counterweights {
+        let (r, phi) = polar(cw.offset);
+        lines.push(format!(
+            "{:<5} m = {:.3} kg, r = {:.1} mm, φ = {:.4} rad   (on {})",
+            label(cw.entry),
+            cw.mass,
+            r * 1e3,
+            phi,
+            model.bodies[cw.body].name
+        ));
+    }
+    for s in &w.springs {
+        let (a, alpha) = polar(s.anchor_a);
+        let (b, beta) = polar(s.anchor_b);
+        let other = match s.other {
+            Attachment::Base => "base".to_string(),
+            Attachment::Body(i) => model.bodies[i].name.clone(),
+        };
+        lines.push(format!(
+            "{:<5} K = {:.4} N/mm, a = {:.1} mm, α = {:.4} rad, b = {:.1} mm, β = {:.4} rad   ({}–{})",
+            label(s.entry),
+            s.stiffness * 1e-3,
+            a * 1e3,
+            alpha,
+            b * 1e3,
+            beta,
+            model.bodies[s.body].name,
+            other
+        ));
+    }
+    lines
+}
+
+/// The human-readable report.
+pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -> String {
+    let mut out = String::new();
+    let (cw, springs) = report.catalogue.counts();
+    out.push_str(&format!(
+        "{}: {} elements ({cw} counterweights, {springs} springs), Dmax {dmax} → {} variants in {:.3} s\n\n",
+        model.name,
+        report.catalogue.len(),
+        report.variants.len(),
+        seconds
+    ));
+    out.push_str(&format!("{:<14}", "status"));
+    let classes = [Class::Counterweights, Class::Springs, Class::Hybrid];
+    for c in classes {
+        out.push_str(&format!("{:>16}", c.name()));
+    }
+    out.push_str(&format!("{:>10}\n", "total"));
+    for status in Status::ALL {
+        out.push_str(&format!("{:<14}", status.name()));
+        for c in classes {
+            out.push_str(&format!("{:>16}", report.count_class(status, c)));
+        }
+        out.push_str(&format!("{:>10}\n", report.count(status)));
+    }
+    out.push('\n');
+    for v in report
+        .variants
+        .iter()
+        .filter(|v| v.status == Status::Balanced)
+    {
+        let labels: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
+        out.push_str(&format!(
+            "{{{}}}  {}  free parameters: {}  verification residual {:.1e}\n",
+            labels.join(", "),
+            v.class.name(),
+            v.nullity,
+            v.verification.map_or(f64::NAN, |x| x.residual)
+        ));
+        if !v.redundant.is_empty() {
+            out.push_str(&format!(
+                "    redundant (no effect on balance): {}\n",
+                v.redundant.join(", ")
+            ));
+        }
+        for line in witness_lines(model, v) {
+            out.push_str(&format!("    {line}\n"));
+        }
+        for r in &v.relations {
+            out.push_str(&format!("    relation: {r}\n"));
+        }
+    }
+    let others: Vec<&VariantResult> = report
+        .variants
+        .iter()
+        .filter(|v| matches!(v.status, Status::Undecided | Status::Unrealizable))
+        .collect();
+    if !others.is_empty() {
+        out.push_str("\nunrealizable or undecided:\n");
+        for v in others {
+            let labels: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
+            out.push_str(&format!(
+                "{{{}}}  {}: {}\n",
+                labels.join(", "),
+                v.status.name(),
+                v.reason.as_deref().unwrap_or("")
+            ));
+        }
+    }
+    out
+}

@@ -1,0 +1,10 @@
+//! counterpoise: find every way to statically balance a mechanism with counterweights and
+//! springs, tune each for low motor effort, and rank them.
+//!
+//! This package is the command-line tool and a facade over the stage crates:
+//! [`symbolic`] (trigonometric-polynomial algebra), [`model`] (case format, validation,
+//! kinematics), [`balance`] (exact balancing search).
+
+pub use counterpoise_balance as balance;
+pub use counterpoise_model as model;
+pub use counterpoise_symbolic as symbolic;
