@@ -134,7 +134,9 @@ impl<'de, V: Deserialize<'de>> Deserialize<'de> for NamedMap<V> {
                 let mut entries: Vec<(String, V)> = Vec::new();
                 while let Some(key) = access.next_key::<String>()? {
                     if entries.iter().any(|(k, _)| *k == key) {
-                        return Err(de::Error::custom(format!("duplicate key `{key}`")));
+                        // Fail inside the value so that the error's path ends with the key.
+                        access.next_value_seed(Duplicate(key))?;
+                        unreachable!("a duplicate key always fails");
                     }
                     let value = access.next_value::<V>()?;
                     entries.push((key, value));
@@ -143,6 +145,18 @@ impl<'de, V: Deserialize<'de>> Deserialize<'de> for NamedMap<V> {
             }
         }
         deserializer.deserialize_map(MapVisitor(PhantomData))
+    }
+}
+
+/// Consumes the value of a repeated key and fails with a "duplicate key" error.
+struct Duplicate(String);
+
+impl<'de> de::DeserializeSeed<'de> for Duplicate {
+    type Value = ();
+
+    fn deserialize<D: Deserializer<'de>>(self, deserializer: D) -> Result<Self::Value, D::Error> {
+        de::IgnoredAny::deserialize(deserializer)?;
+        Err(de::Error::custom(format!("duplicate key `{}`", self.0)))
     }
 }
 

@@ -51,6 +51,18 @@ fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
 }
 
+/// A value with four significant digits, in plain notation when that is readable.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        format!("{x}")
+    } else if !(1e-3..1e4).contains(&x.abs()) {
+        format!("{x:.3e}")
+    } else {
+        let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{x:.digits$}")
+    }
+}
+
 /// A joint as written: geometry in the first body's frame.
 pub(crate) struct JointInput {
     pub name: String,
@@ -67,14 +79,17 @@ pub(crate) struct JointInput {
 /// Worst violation of one kind of agreement over the samples.
 struct Worst {
     what: &'static str,
+    /// Whether the deviation is a length (m) rather than an angle (rad).
+    is_length: bool,
     value: f64,
     sample: usize,
 }
 
 impl Worst {
-    fn new(what: &'static str) -> Self {
+    fn new(what: &'static str, is_length: bool) -> Self {
         Worst {
             what,
+            is_length,
             value: 0.0,
             sample: 0,
         }
@@ -108,12 +123,12 @@ pub(crate) fn derive_and_check(
     let relative_rotation = r0.transpose() * r1;
     let relative_position = r0.transpose() * (o1 - o0);
 
-    let mut points = Worst::new("points differ by");
-    let mut axes = Worst::new("axes differ by");
-    let mut rotation = Worst::new("relative rotation changes by");
-    let mut position = Worst::new("relative position changes by");
-    let mut slide = Worst::new("the second body's point leaves the axis by");
-    let mut perpendicular = Worst::new("axis and axis2 are off perpendicular by");
+    let mut points = Worst::new("points differ by", true);
+    let mut axes = Worst::new("axes differ by", false);
+    let mut rotation = Worst::new("relative rotation changes by", false);
+    let mut position = Worst::new("relative position changes by", true);
+    let mut slide = Worst::new("the second body's point leaves the axis by", true);
+    let mut perpendicular = Worst::new("axis and axis2 are off perpendicular by", false);
 
     for (n, q) in samples.iter().enumerate() {
         let at = Point::new(q, &kinds);
@@ -155,16 +170,14 @@ pub(crate) fn derive_and_check(
     let mut errors = Vec::new();
     for worst in [points, axes, rotation, position, slide, perpendicular] {
         if worst.value > tol || worst.value.is_nan() {
-            let unit_is_length = matches!(
-                worst.what,
-                "points differ by"
-                    | "relative position changes by"
-                    | "the second body's point leaves the axis by"
-            );
-            let amount = if unit_is_length {
-                format!("{:.3e} m", worst.value)
+            let amount = if worst.is_length {
+                format!("{} m", significant(worst.value))
             } else {
-                format!("{:.3e} rad ({:.4}°)", worst.value, worst.value.to_degrees())
+                format!(
+                    "{} rad ({}°)",
+                    significant(worst.value),
+                    significant(worst.value.to_degrees())
+                )
             };
             errors.push(ModelError::JointInconsistent {
                 path: input.path.clone(),

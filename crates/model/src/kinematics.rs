@@ -94,6 +94,9 @@ struct ActuatorTerms {
 pub struct Kinematics {
     pub(crate) coordinates: Vec<Coordinate>,
     kinds: Vec<VarKind>,
+    /// Angles that enter the actuator map only through cos/sin: shifting them by 2π leaves
+    /// `u` unchanged, so Newton may wrap them into their ranges.
+    pub(crate) periodic: Vec<bool>,
     bodies: Vec<PoseTerms>,
     actuators: Vec<ActuatorTerms>,
 }
@@ -148,9 +151,19 @@ impl Kinematics {
                 }
             })
             .collect();
+        let periodic = (0..n)
+            .map(|k| {
+                kinds[k] == VarKind::Angle
+                    && model
+                        .actuators
+                        .iter()
+                        .all(|a| a.coordinate.linear.iter().all(|&(j, c)| j != k || c == 0.0))
+            })
+            .collect();
         Kinematics {
             coordinates: model.coordinates.clone(),
             kinds,
+            periodic,
             bodies,
             actuators,
         }

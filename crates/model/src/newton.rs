@@ -82,8 +82,9 @@ impl Kinematics {
         self.solve_coordinates_with(u_target, q_guess, &NewtonOptions::default())
     }
 
-    /// Damped Newton with a backtracking line search on `|f(q) − u|`. Angles of the solution
-    /// are shifted by multiples of 2π into their ranges when possible.
+    /// Damped Newton with a backtracking line search on `|f(q) − u|`. Angles that enter `u`
+    /// only through cos/sin are shifted by multiples of 2π into their ranges when possible
+    /// (an angle that is itself actuated, `u = θ`, is not: that would change `u`).
     pub fn solve_coordinates_with(
         &self,
         u_target: &DVector<f64>,
@@ -156,13 +157,14 @@ impl Kinematics {
         Ok(q)
     }
 
-    /// Moves angles by multiples of 2π into their ranges; fails for a coordinate outside.
+    /// Moves periodic angles by multiples of 2π into their ranges; fails for a coordinate
+    /// outside its range.
     fn move_into_ranges(&self, q: &mut DVector<f64>) -> Result<(), KinematicsError> {
         let two_pi = std::f64::consts::TAU;
-        for (value, c) in q.iter_mut().zip(&self.coordinates) {
+        for ((value, c), &periodic) in q.iter_mut().zip(&self.coordinates).zip(&self.periodic) {
             let [lo, hi] = c.range;
             let slack = 1e-9 * (hi - lo);
-            if c.kind == VarKind::Angle && !(lo - slack..=hi + slack).contains(value) {
+            if periodic && !(lo - slack..=hi + slack).contains(value) {
                 let shifted = *value - two_pi * ((*value - lo) / two_pi).floor();
                 if shifted <= hi + slack {
                     *value = shifted;

@@ -333,7 +333,12 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
 
     // ---- joints: shape first, then consistency at sampled configurations
     let samples = sample_configurations(&coordinates, VALIDATION_SAMPLES, DEFAULT_SEED);
-    let all_poses: Option<Vec<PolyPose>> = world.iter().cloned().collect();
+    // Bodies without a pose (already reported) stand at the origin; no joint touching one is
+    // checked.
+    let poses: Vec<PolyPose> = world
+        .iter()
+        .map(|p| p.clone().unwrap_or_else(PolyPose::identity))
+        .collect();
     let length = characteristic_length(&case, &coordinates, &world, &parser, coordinates_ok);
     let tolerance = JOINT_TOLERANCE * (1.0 + length);
     let mut joint_names = HashMap::new();
@@ -351,10 +356,6 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
                 if !(posed && coordinates_ok) {
                     return None;
                 }
-                let poses: Vec<PolyPose> = world
-                    .iter()
-                    .map(|p| p.clone().unwrap_or_else(PolyPose::identity))
-                    .collect();
                 match joints::derive_and_check(&input, &poses, &coordinates, &samples, tolerance) {
                     Ok(joint) => Some(joint),
                     Err(errors) => {
@@ -404,11 +405,11 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
         };
         v.positive(a.ratio, &format!("{path}.ratio"));
         if let (Some(map), Some(k)) = (map, joint_index) {
-            if let (Some(Some(joint)), Some(poses)) = (joints.get(k), &all_poses)
+            if let Some(Some(joint)) = joints.get(k)
                 && let Some(problem) = joints::check_actuator_follows_joint(
                     &map,
                     joint,
-                    poses,
+                    &poses,
                     &coordinates,
                     &samples,
                     ACTUATOR_TOLERANCE,
