@@ -304,14 +304,14 @@ pub fn task_series_with(
                 .actuator_force
                 .push(view.actuator_force[0][..n].to_vec());
             series.motor_torque.push(view.motor_torque[0][..n].to_vec());
-            for (js, (f, m)) in series.joints.iter_mut().zip(
-                view.reactions[0]
-                    .force
-                    .iter()
-                    .zip(&view.reactions[0].moment),
-            ) {
-                js.force.push(*f);
-                js.moment.push(*m);
+            let r = &view.reactions[0];
+            for (js, (f, m)) in series
+                .joints
+                .iter_mut()
+                .zip(r.force_magnitudes().zip(r.moment_magnitudes()))
+            {
+                js.force.push(f);
+                js.moment.push(m);
             }
         },
     )

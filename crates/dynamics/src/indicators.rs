@@ -61,12 +61,16 @@ impl StatsAccumulator {
         self.samples += 1;
     }
 
-    pub fn add_reactions(&mut self, force: &[f64], moment: &[f64]) {
+    pub fn add_reactions(
+        &mut self,
+        force: impl Iterator<Item = f64>,
+        moment: impl Iterator<Item = f64>,
+    ) {
         for (p, f) in self.force_peak.iter_mut().zip(force) {
-            *p = p.max(*f);
+            *p = p.max(f);
         }
         for (p, m) in self.moment_peak.iter_mut().zip(moment) {
-            *p = p.max(*m);
+            *p = p.max(m);
         }
     }
 

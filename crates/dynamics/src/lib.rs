@@ -6,6 +6,10 @@
 //! with it ([`runner`]). Entry points: [`evaluate`] (the `evaluate` command),
 //! [`task_series`] (one task's time series), [`evaluate_grid`] (many parameter vectors).
 
+// Index loops over small fixed-size numeric arrays read like the formulas they implement, and
+// the hot-loop entry points take their buffers explicitly rather than bundled.
+#![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
+
 pub mod compiled;
 pub mod error;
 pub mod evaluate;

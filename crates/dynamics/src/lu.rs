@@ -15,6 +15,9 @@ pub struct SmallLu {
     perm: [usize; MAX_VARS],
     /// `min |u_ii| / max |u_ii|` (0 for an exactly singular matrix).
     pub pivot_ratio: f64,
+    /// `min |u_ii|` and `max |u_ii|`.
+    pub min_pivot: f64,
+    pub max_pivot: f64,
 }
 
 impl SmallLu {
@@ -65,6 +68,12 @@ impl SmallLu {
             lu,
             perm,
             pivot_ratio,
+            min_pivot: if min_pivot.is_finite() {
+                min_pivot
+            } else {
+                0.0
+            },
+            max_pivot,
         }
     }
 

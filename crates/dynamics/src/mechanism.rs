@@ -16,8 +16,10 @@ use crate::compiled::{BankScratch, PolyBank};
 use crate::error::{DynamicsError, FailureReason};
 use crate::lu::SmallLu;
 
-/// `G` counts as singular when `min |u_ii| / max |u_ii|` of its LU falls below this.
-pub const SINGULAR_PIVOT_RATIO: f64 = 1e-9;
+/// `G` counts as singular when the smallest pivot of its LU falls below this fraction of the
+/// larger of its largest pivot and the typical size of `G` over the coordinate ranges (the
+/// latter makes the test meaningful for a single actuator, where the pivot ratio is always 1).
+pub const SINGULAR_PIVOT_RATIO: f64 = 1e-7;
 /// Newton converged when `max |f(q) − u| ≤ NEWTON_TOLERANCE · (1 + max |u|)`.
 pub const NEWTON_TOLERANCE: f64 = 1e-12;
 const NEWTON_MAX_ITERATIONS: usize = 50;
@@ -102,6 +104,8 @@ pub struct Mechanism {
     act_linear: Vec<Vec<(usize, f64)>>,
     /// Per actuator, `∂²f_a/∂q_k∂q_l` packed.
     act2_bank: PolyBank,
+    /// Largest `|G_ij|` over the reference configuration and 32 sampled configurations.
+    pub g_scale: f64,
 }
 
 impl Mechanism {
@@ -161,7 +165,7 @@ impl Mechanism {
             act_polys.extend(first);
             act2_polys.extend(second);
         }
-        Ok(Mechanism {
+        let mut mech = Mechanism {
             n,
             kinds: kinds.clone(),
             coordinate_names: model.coordinates.iter().map(|c| c.name.clone()).collect(),
@@ -176,7 +180,37 @@ impl Mechanism {
                 .map(|a| a.coordinate.linear.clone())
                 .collect(),
             act2_bank: PolyBank::new(&act2_polys, &kinds),
-        })
+            g_scale: 0.0,
+        };
+        let mut rng = counterpoise_model::sampling::SplitMix64::new(0x6475_6e61_6d69_6373);
+        let mut scratch = Scratch::default();
+        let mut u = [0.0; MAX_VARS];
+        let mut g = [0.0; MAX_VARS * MAX_VARS];
+        let mut scale = 0.0f64;
+        for s in 0..33 {
+            let q: Vec<f64> = if s == 0 {
+                model.reference_configuration()
+            } else {
+                mech.ranges
+                    .iter()
+                    .map(|r| rng.uniform(r[0], r[1]))
+                    .collect()
+            };
+            mech.actuator_map(&q, &mut scratch, &mut u, &mut g);
+            scale = g[..n * n].iter().fold(scale, |m, x| m.max(x.abs()));
+        }
+        mech.g_scale = if scale > 0.0 { scale } else { 1.0 };
+        Ok(mech)
+    }
+
+    /// Whether an LU of `G` is singular (see [`SINGULAR_PIVOT_RATIO`]); returns the ratio.
+    pub fn singularity(&self, lu: &SmallLu) -> Result<(), FailureReason> {
+        let ratio = lu.min_pivot / lu.max_pivot.max(self.g_scale);
+        if ratio >= SINGULAR_PIVOT_RATIO {
+            Ok(())
+        } else {
+            Err(FailureReason::Singular { pivot_ratio: ratio })
+        }
     }
 
     /// Values per body in the pose bank.
@@ -335,17 +369,13 @@ impl Mechanism {
         self.actuator_map(q, scratch, &mut f, &mut g);
         let (mut rmax, mut rnorm) = residual_of(&f);
         let mut iterations = 0;
-        while !(rmax <= tol) {
+        while rmax > tol || rmax.is_nan() {
             if iterations == NEWTON_MAX_ITERATIONS || !rmax.is_finite() {
                 return Err(FailureReason::NotConverged { residual: rmax });
             }
             iterations += 1;
             let lu = SmallLu::new(&g, n);
-            if !(lu.pivot_ratio >= SINGULAR_PIVOT_RATIO) {
-                return Err(FailureReason::Singular {
-                    pivot_ratio: lu.pivot_ratio,
-                });
-            }
+            self.singularity(&lu)?;
             let mut step = [0.0; MAX_VARS];
             for a in 0..n {
                 step[a] = u[a] - f[a];
@@ -427,11 +457,7 @@ impl Mechanism {
         let mut g = [0.0; MAX_VARS * MAX_VARS];
         self.actuator_map(q, scratch, &mut f, &mut g);
         let lu = SmallLu::new(&g, n);
-        if !(lu.pivot_ratio >= SINGULAR_PIVOT_RATIO) {
-            return Err(FailureReason::Singular {
-                pivot_ratio: lu.pivot_ratio,
-            });
-        }
+        self.singularity(&lu)?;
         qd[..n].copy_from_slice(&ud[..n]);
         lu.solve(qd);
         let mut bias = [0.0; MAX_VARS];

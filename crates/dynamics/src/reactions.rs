@@ -83,11 +83,24 @@ fn perpendiculars(e: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     (e1, e2)
 }
 
-/// Reaction magnitudes of one sample for one parameter column, per joint.
+/// Joint reactions of one sample for one parameter column: per joint the force and the
+/// moment (about the joint point) that the joint's first body exerts on its second, world axes.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct ReactionMagnitudes {
-    pub force: Vec<f64>,
-    pub moment: Vec<f64>,
+pub struct JointReactions {
+    pub force: Vec<Vector3<f64>>,
+    pub moment: Vec<Vector3<f64>>,
+}
+
+impl JointReactions {
+    /// `|F_j|` per joint.
+    pub fn force_magnitudes(&self) -> impl Iterator<Item = f64> + '_ {
+        self.force.iter().map(|f| f.norm())
+    }
+
+    /// `|M_j|` per joint.
+    pub fn moment_magnitudes(&self) -> impl Iterator<Item = f64> + '_ {
+        self.moment.iter().map(|m| m.norm())
+    }
 }
 
 /// Builds and solves the reaction equations.
@@ -255,7 +268,7 @@ impl ReactionSolver {
         a
     }
 
-    /// Reaction magnitudes for every parameter column at one sample.
+    /// Joint reactions for every parameter column at one sample.
     ///
     /// `reg` holds the sample's body kinematics and wrench regressors, `lu` the LU of `G`,
     /// `actuator_forces[p]` the actuator forces `Q_u` of column `p`.
@@ -269,7 +282,7 @@ impl ReactionSolver {
         params: &ParameterSet,
         columns: &[usize],
         actuator_forces: &[[f64; counterpoise_symbolic::MAX_VARS]],
-    ) -> Vec<ReactionMagnitudes> {
+    ) -> Vec<JointReactions> {
         let kin = &reg.kin;
         let frames = self.frames(mech, pose);
         let a = self.matrix(&frames, kin);
@@ -347,7 +360,7 @@ impl ReactionSolver {
         let lambda = self.min_norm_solve(&a, &b, kin, mech.n);
         (0..columns.len())
             .map(|c| {
-                let mut out = ReactionMagnitudes::default();
+                let mut out = JointReactions::default();
                 for (j, f) in self.joints.iter().zip(&frames) {
                     let mut force = Vector3::zeros();
                     let mut moment = Vector3::zeros();
@@ -360,8 +373,8 @@ impl ReactionSolver {
                         moment += e * lambda[(col, c)];
                         col += 1;
                     }
-                    out.force.push(force.norm());
-                    out.moment.push(moment.norm());
+                    out.force.push(force);
+                    out.moment.push(moment);
                 }
                 out
             })

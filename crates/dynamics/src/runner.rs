@@ -14,7 +14,7 @@ use crate::law::{quintic_move, sample_time};
 use crate::lu::SmallLu;
 use crate::mechanism::{Mechanism, Scratch};
 use crate::params::ParameterSet;
-use crate::reactions::{ReactionMagnitudes, ReactionSolver};
+use crate::reactions::{JointReactions, ReactionSolver};
 use crate::regressor::SampleRegressor;
 
 /// One sample of a move as seen by a consumer.
@@ -25,12 +25,14 @@ pub struct SampleView {
     pub q: Vec<f64>,
     pub qd: Vec<f64>,
     pub qdd: Vec<f64>,
+    /// Per column: generalized force per chart coordinate, `Q_q`.
+    pub chart_force: Vec<[f64; MAX_VARS]>,
     /// Per column: generalized force per actuated coordinate (before the ratio).
     pub actuator_force: Vec<[f64; MAX_VARS]>,
     /// Per column: motor torque per actuator.
     pub motor_torque: Vec<[f64; MAX_VARS]>,
     /// Per column (empty without reactions).
-    pub reactions: Vec<ReactionMagnitudes>,
+    pub reactions: Vec<JointReactions>,
 }
 
 /// Per-worker buffers.
@@ -74,8 +76,10 @@ impl<'m> Evaluator<'m> {
         self.model.joints.iter().map(|j| j.name.clone()).collect()
     }
 
-    /// `q` with `f(q) = u`, from the reference configuration; if the direct Newton fails,
-    /// by continuation along the straight line from `f(q_ref)` to `u`.
+    /// `q` with `f(q) = u`: from the reference configuration (range midpoints), first directly,
+    /// then by continuation along the straight line from `f(q_ref)` to `u`; if that fails
+    /// (e.g. `G` is singular at the reference), directly from 32 deterministic pseudo-random
+    /// configurations in the coordinate ranges. The first success wins.
     pub fn solve_point(&self, u: &[f64]) -> Result<Vec<f64>, FailureReason> {
         let n = self.mech.n;
         let q_ref = self.model.reference_configuration();
@@ -84,7 +88,7 @@ impl<'m> Evaluator<'m> {
         let mut g = [0.0; MAX_VARS * MAX_VARS];
         self.mech
             .actuator_map(&q_ref, &mut scratch, &mut u_ref, &mut g);
-        let mut last = FailureReason::NotConverged { residual: f64::NAN };
+        let mut first_error = None;
         for steps in [1usize, 8, 64] {
             let mut q = q_ref.clone();
             let mut ok = true;
@@ -92,7 +96,7 @@ impl<'m> Evaluator<'m> {
                 let w = s as f64 / steps as f64;
                 let target: Vec<f64> = (0..n).map(|a| u_ref[a] + w * (u[a] - u_ref[a])).collect();
                 if let Err(e) = self.mech.solve(&target, &mut q, &mut scratch) {
-                    last = e;
+                    first_error.get_or_insert(e);
                     ok = false;
                     break;
                 }
@@ -101,7 +105,19 @@ impl<'m> Evaluator<'m> {
                 return Ok(q);
             }
         }
-        Err(last)
+        let mut rng = counterpoise_model::sampling::SplitMix64::new(0x7374_6172_7473);
+        for _ in 0..32 {
+            let mut q: Vec<f64> = self
+                .mech
+                .ranges
+                .iter()
+                .map(|r| rng.uniform(r[0], r[1]))
+                .collect();
+            if self.mech.solve(u, &mut q, &mut scratch).is_ok() {
+                return Ok(q);
+            }
+        }
+        Err(first_error.unwrap_or(FailureReason::NotConverged { residual: f64::NAN }))
     }
 
     /// Runs a quintic rest-to-rest move from `ua` to `ub`, calling `sink` at every sample.
@@ -185,9 +201,11 @@ impl<'m> Evaluator<'m> {
         view.qdd.extend_from_slice(qdd);
         view.actuator_force.clear();
         view.motor_torque.clear();
+        view.chart_force.clear();
         for &p in columns {
             let mut f = [0.0; MAX_VARS];
             ws.reg.generalized_force(n, params.column(p), &mut f);
+            view.chart_force.push(f);
             lu.solve_transpose(&mut f);
             let mut m = [0.0; MAX_VARS];
             for a in 0..n {
@@ -210,15 +228,49 @@ impl<'m> Evaluator<'m> {
                 columns,
                 &view.actuator_force,
             );
-            if view
-                .reactions
-                .iter()
-                .any(|r| r.force.iter().chain(&r.moment).any(|x| !x.is_finite()))
-            {
+            if view.reactions.iter().any(|r| {
+                r.force
+                    .iter()
+                    .chain(&r.moment)
+                    .any(|x| !x.iter().all(|v| v.is_finite()))
+            }) {
                 return Err(FailureReason::NonFinite);
             }
         }
         Ok(())
+    }
+
+    /// Dynamics at an arbitrary state `(q, q̇, q̈)` (no Newton: `q` is taken as given).
+    #[allow(clippy::too_many_arguments)]
+    pub fn at_state(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        params: &ParameterSet,
+        columns: &[usize],
+        with_reactions: bool,
+    ) -> Result<SampleView, FailureReason> {
+        let n = self.mech.n;
+        let mut ws = Workspace::default();
+        let mut u = [0.0; MAX_VARS];
+        let mut g = [0.0; MAX_VARS * MAX_VARS];
+        self.mech.actuator_map(q, &mut ws.scratch, &mut u, &mut g);
+        let lu = SmallLu::new(&g, n);
+        self.mech.singularity(&lu)?;
+        self.sample(
+            0.0,
+            &u[..n],
+            q,
+            qd,
+            qdd,
+            &lu,
+            params,
+            columns,
+            with_reactions,
+            &mut ws,
+        )?;
+        Ok(ws.view)
     }
 
     /// Statistics of one move for every column.
@@ -256,7 +308,8 @@ impl<'m> Evaluator<'m> {
                 for (c, a) in acc.iter_mut().enumerate() {
                     a.add_torques(&view.motor_torque[c][..na]);
                     if with_reactions {
-                        a.add_reactions(&view.reactions[c].force, &view.reactions[c].moment);
+                        let r = &view.reactions[c];
+                        a.add_reactions(r.force_magnitudes(), r.moment_magnitudes());
                     }
                 }
             },

@@ -40,7 +40,7 @@ impl TaskSet {
                 "{samples} samples per task; at least 2 (both ends) are needed"
             )));
         }
-        if !(tasks.duration > 0.0) {
+        if tasks.duration.is_nan() || tasks.duration <= 0.0 {
             return Err(DynamicsError::BadGrid(format!(
                 "duration {} must be positive",
                 tasks.duration

@@ -1,0 +1,176 @@
+//! The `evaluate` logic: failures are reported, not fatal; results do not depend on the
+//! thread count; the report has the documented fields.
+
+mod common;
+
+use common::{case, case_from_text};
+use counterpoise_dynamics::{
+    Counterweight, EvaluateOptions, ParameterSet, Spring, Variant, evaluate, evaluate_grid,
+    task_series,
+};
+use counterpoise_model::{GridAxis, Model};
+
+/// The palletizer on a coarse 3×3×3 grid (351 tasks) with 11 samples per task.
+fn coarse_palletizer() -> Model {
+    let mut model = case("palletizer");
+    let tasks = model.tasks.as_mut().unwrap();
+    for axis in &mut tasks.grid {
+        axis.n = 3;
+    }
+    tasks.samples = 11;
+    model
+}
+
+#[test]
+fn unreachable_tasks_are_excluded_not_fatal() {
+    let mut model = coarse_palletizer();
+    // ρ2 up to 0.6 m: beyond the pantograph's reach (ρ2 ≤ δ3 + δ1 + δ4 = 0.35 m).
+    model.tasks.as_mut().unwrap().grid[1] = GridAxis {
+        from: 0.0,
+        to: 0.6,
+        n: 3,
+    };
+    let report = evaluate(&model, &EvaluateOptions::default()).unwrap();
+    assert!(report.excluded.count > 0);
+    assert!(report.evaluated > 0);
+    assert_eq!(report.evaluated + report.excluded.count, report.tasks);
+    assert!(report.indicators.qtr.is_finite() && report.indicators.qit.is_finite());
+    for j in &report.indicators.joints {
+        assert!(j.force.is_finite() && j.moment.is_finite());
+    }
+    // every excluded task touches a point with ρ2 = 0.6 (middle grid index 2)
+    for f in &report.excluded.examples {
+        let (i, j) = report_pair(&model, f.task);
+        assert!(
+            i / 3 % 3 >= 1 || j / 3 % 3 >= 1,
+            "task {i}->{j} excluded: {:?}",
+            f.reason
+        );
+    }
+    let json = serde_json::to_value(&report).unwrap();
+    assert!(
+        !json["excluded"]["by_reason"]
+            .as_object()
+            .unwrap()
+            .is_empty()
+    );
+}
+
+fn report_pair(model: &Model, task: usize) -> (usize, usize) {
+    let set = counterpoise_dynamics::TaskSet::new(model.tasks.as_ref().unwrap(), None).unwrap();
+    set.pair(task)
+}
+
+#[test]
+fn singular_actuator_jacobian_is_reported() {
+    // u = x³: G = 3x² vanishes at x = 0 (u = 0), a reachable point.
+    let model = case_from_text(
+        r#"{
+        "name": "cubic", "gravity": [0, -9.81, 0],
+        "coordinates": [ { "name": "x", "kind": "length", "range": [-2, 2] } ],
+        "bodies": [ { "name": "slider", "parent": "base", "pose": [ { "translate": ["x^3", 0, 0] } ],
+                      "mass": 1, "com": [0, 0, 0], "inertia": [0.1, 0.1, 0.1, 0, 0, 0] } ],
+        "joints": [ { "name": "J1", "kind": "prismatic", "bodies": ["base", "slider"],
+                      "point": [0, 0, 0], "axis": [1, 0, 0] } ],
+        "actuators": [ { "name": "M1", "joint": "J1", "coordinate": "x^3", "ratio": 1 } ],
+        "tasks": { "grid": { "M1": [0, 2, 3] }, "duration": 1, "samples": 11 }
+    }"#,
+    );
+    let report = evaluate(
+        &model,
+        &EvaluateOptions {
+            samples: None,
+            reactions: false,
+        },
+    )
+    .unwrap();
+    assert_eq!(report.tasks, 3);
+    assert_eq!(report.excluded.count, 2, "{:?}", report.excluded);
+    assert_eq!(report.excluded.by_reason.get("singular"), Some(&2));
+    assert_eq!(report.evaluated, 1);
+    assert_eq!(report.indicators.actuators[0].crt, [1, 2]);
+    assert!(report.indicators.qtr.is_finite());
+    assert!(task_series(&model, 0, 2, None).is_err());
+}
+
+#[test]
+fn same_results_with_one_and_two_threads() {
+    let model = coarse_palletizer();
+    let variants = vec![
+        Variant::default(),
+        Variant {
+            counterweights: vec![Counterweight {
+                body: 3,
+                mass: 80.0,
+                position: [-0.4, 0.1, 0.0],
+            }],
+            springs: vec![Spring {
+                body: 3,
+                other: Some(2),
+                stiffness: 5000.0,
+                anchor: [0.5, 0.0, 0.0],
+                other_anchor: [0.0, 0.2, 0.0],
+            }],
+        },
+    ];
+    let params = ParameterSet::from_variants(&model, &variants).unwrap();
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| evaluate_grid(&model, &params, &EvaluateOptions::default()).unwrap())
+    };
+    let one = run(1);
+    let two = run(2);
+    assert_eq!(one.indicators, two.indicators, "bit-for-bit identical");
+    assert_eq!(one.stats, two.stats);
+    assert_eq!(one.excluded, two.excluded);
+    assert_eq!(one.excluded.count, 0);
+    assert_ne!(one.indicators[0], one.indicators[1]);
+}
+
+#[test]
+fn report_fields() {
+    let model = coarse_palletizer();
+    let report = evaluate(&model, &EvaluateOptions::default()).unwrap();
+    assert_eq!(report.points, 27);
+    assert_eq!(report.tasks, 351);
+    assert!(report.reactions_minimum_norm);
+    let json = serde_json::to_value(&report).unwrap();
+    for key in [
+        "qtr",
+        "qit",
+        "qtr_task",
+        "qit_task",
+        "actuators",
+        "joints",
+        "excluded",
+    ] {
+        assert!(json.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(json["actuators"][0]["crt"].as_array().unwrap().len(), 2);
+    assert_eq!(report.indicators.joints.len(), model.joints.len());
+    // M1 turns about the vertical: its torque is inertial only, far below M3's gravity load
+    assert!(report.indicators.actuators[0].crt_rms < report.indicators.actuators[2].crt_rms);
+    // the QTR task's total RMS is the largest, and QIT ≥ every actuator's peak
+    for a in &report.indicators.actuators {
+        assert!(report.indicators.qit >= a.cpt_peak);
+    }
+    let s = task_series(
+        &model,
+        report.indicators.qtr_task[0],
+        report.indicators.qtr_task[1],
+        None,
+    )
+    .unwrap();
+    assert_eq!(s.t.len(), 11);
+    let rms: f64 = (0..3)
+        .map(|a| (s.motor_torque.iter().map(|m| m[a] * m[a]).sum::<f64>() / 11.0).sqrt())
+        .sum();
+    assert!(
+        (rms - report.indicators.qtr).abs() < 1e-9 * report.indicators.qtr,
+        "{rms} vs {}",
+        report.indicators.qtr
+    );
+}

@@ -1,0 +1,265 @@
+//! The palletizer against independent derivations: the Lagrangian by finite differences, the
+//! static actuator forces as ∂V/∂u, whole-mechanism balance of the joint reactions, and the
+//! time-reversal symmetry.
+
+mod common;
+
+use common::case;
+use counterpoise_dynamics::runner::Workspace;
+use counterpoise_dynamics::{Evaluator, ParameterSet};
+use counterpoise_model::sampling::SplitMix64;
+use counterpoise_model::{Kinematics, Model, PayloadMode};
+use counterpoise_symbolic::Point;
+use nalgebra::{DVector, Matrix3, Vector3};
+
+fn rot(m: &counterpoise_symbolic::PolyMat3, at: &Point) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| m.0[i][j].eval(at))
+}
+
+fn vec3(v: &counterpoise_symbolic::PolyVec3, at: &Point) -> Vector3<f64> {
+    Vector3::from_fn(|i, _| v.0[i].eval(at))
+}
+
+/// Kinetic energy from the symbolic pose polynomials: `Σ ½ m |ṗ_c|² + ½ ω_bᵀ I_c ω_b`.
+fn kinetic(model: &Model, q: &[f64], qd: &[f64]) -> f64 {
+    let kinds = model.kinds();
+    let at = model.point(q);
+    let mut t = 0.0;
+    for b in &model.bodies {
+        let r = rot(&b.rotation, &at);
+        let mut rd = Matrix3::zeros();
+        let mut vc = Vector3::zeros();
+        for k in 0..q.len() {
+            let rk = rot(&b.rotation.derivative(k, kinds[k]), &at);
+            let pk = vec3(&b.origin.derivative(k, kinds[k]), &at);
+            rd += rk * qd[k];
+            vc += (pk + rk * b.com) * qd[k];
+        }
+        let w = rd * r.transpose();
+        let wb = r.transpose() * Vector3::new(w[(2, 1)], w[(0, 2)], w[(1, 0)]);
+        t += 0.5 * b.mass * vc.norm_squared() + 0.5 * wb.dot(&(b.inertia_com * wb));
+    }
+    t
+}
+
+fn potential(model: &Model, q: &[f64]) -> f64 {
+    model
+        .potential_energy(PayloadMode::All)
+        .eval(&model.point(q))
+}
+
+fn random_state(model: &Model, rng: &mut SplitMix64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let q = model
+        .coordinates
+        .iter()
+        .map(|c| {
+            let m = c.midpoint();
+            let h = 0.3 * (c.range[1] - c.range[0]);
+            rng.uniform(m - h, m + h)
+        })
+        .collect();
+    let qd = (0..model.dof()).map(|_| rng.uniform(-1.0, 1.0)).collect();
+    let qdd = (0..model.dof()).map(|_| rng.uniform(-2.0, 2.0)).collect();
+    (q, qd, qdd)
+}
+
+#[test]
+fn generalized_forces_match_the_lagrangian() {
+    let model = case("palletizer");
+    let ev = Evaluator::new(&model).unwrap();
+    let params = ParameterSet::unbalanced(&model);
+    let n = model.dof();
+    let mut rng = SplitMix64::new(7);
+    for _ in 0..6 {
+        let (q, qd, qdd) = random_state(&model, &mut rng);
+        let view = ev.at_state(&q, &qd, &qdd, &params, &[0], false).unwrap();
+        let ours = &view.chart_force[0];
+        // ∂T/∂q̇_k by central differences (T is exactly quadratic in q̇).
+        let dt_dqd = |q: &[f64], qd: &[f64], k: usize| {
+            let d = 1e-3;
+            let mut p = qd.to_vec();
+            let mut m = qd.to_vec();
+            p[k] += d;
+            m[k] -= d;
+            (kinetic(&model, q, &p) - kinetic(&model, q, &m)) / (2.0 * d)
+        };
+        let mut scale = 0.0f64;
+        let mut lagrange = vec![0.0; n];
+        for k in 0..n {
+            let h = 1e-4;
+            let along = |s: f64| -> (Vec<f64>, Vec<f64>) {
+                (
+                    (0..n)
+                        .map(|i| q[i] + qd[i] * s + 0.5 * qdd[i] * s * s)
+                        .collect(),
+                    (0..n).map(|i| qd[i] + qdd[i] * s).collect(),
+                )
+            };
+            let (qp, qdp) = along(h);
+            let (qm, qdm) = along(-h);
+            let ddt = (dt_dqd(&qp, &qdp, k) - dt_dqd(&qm, &qdm, k)) / (2.0 * h);
+            let e = 1e-5;
+            let mut qp = q.clone();
+            let mut qm = q.clone();
+            qp[k] += e;
+            qm[k] -= e;
+            let dtdq = (kinetic(&model, &qp, &qd) - kinetic(&model, &qm, &qd)) / (2.0 * e);
+            let dvdq = (potential(&model, &qp) - potential(&model, &qm)) / (2.0 * e);
+            lagrange[k] = ddt - dtdq + dvdq;
+            scale = scale.max(lagrange[k].abs());
+        }
+        for k in 0..n {
+            assert!(
+                (ours[k] - lagrange[k]).abs() < 1e-6 * scale,
+                "Q_{k}: {} vs Lagrange {} at q = {q:?}",
+                ours[k],
+                lagrange[k]
+            );
+        }
+    }
+}
+
+#[test]
+fn static_actuator_forces_are_dv_du() {
+    let model = case("palletizer");
+    let ev = Evaluator::new(&model).unwrap();
+    let kin = Kinematics::new(&model);
+    let params = ParameterSet::unbalanced(&model);
+    let n = model.dof();
+    let zeros = vec![0.0; n];
+    for u0 in [[0.5, 0.1, 1.2], [2.0, 0.0, 1.03], [0.0, 0.266667, 1.37]] {
+        let q = kin
+            .solve_coordinates(
+                &DVector::from_row_slice(&u0),
+                &DVector::from_vec(model.reference_configuration()),
+            )
+            .unwrap();
+        let q: Vec<f64> = q.iter().copied().collect();
+        let view = ev
+            .at_state(&q, &zeros, &zeros, &params, &[0], true)
+            .unwrap();
+        for a in 0..n {
+            let h = 1e-5;
+            let v_at = |d: f64| {
+                let mut u = u0;
+                u[a] += d;
+                let qq = kin
+                    .solve_coordinates(&DVector::from_row_slice(&u), &DVector::from_vec(q.clone()))
+                    .unwrap();
+                potential(&model, qq.as_slice())
+            };
+            let dvdu = (v_at(h) - v_at(-h)) / (2.0 * h);
+            let ours = view.actuator_force[0][a];
+            assert!(
+                (ours - dvdu).abs() < 1e-5 * (1.0 + dvdu.abs()),
+                "actuator {a} at u = {u0:?}: {ours} vs dV/du {dvdu}"
+            );
+        }
+        // M1 drives a rotation about the vertical: no static load
+        assert!(view.actuator_force[0][0].abs() < 1e-9);
+    }
+}
+
+/// Newton–Euler of a body about its CoM from the model crate's kinematics (independent of the
+/// dynamics crate): the wrench the world must apply, as (force, moment about the world origin).
+fn inertial_wrench(
+    model: &Model,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+) -> (Vector3<f64>, Vector3<f64>) {
+    let kin = Kinematics::new(model);
+    let motions = kin.body_motions(
+        &DVector::from_row_slice(q),
+        &DVector::from_row_slice(qd),
+        &DVector::from_row_slice(qdd),
+    );
+    let mut force = Vector3::zeros();
+    let mut moment = Vector3::zeros();
+    for (b, m) in model.bodies.iter().zip(&motions) {
+        let r = m.rotation;
+        let c = r * b.com;
+        let w = m.angular_velocity;
+        let al = m.angular_acceleration;
+        let ac = m.acceleration + al.cross(&c) + w.cross(&w.cross(&c));
+        let f = (ac - model.gravity) * b.mass;
+        let iw = r * b.inertia_com * r.transpose();
+        let nc = iw * al + w.cross(&(iw * w));
+        force += f;
+        moment += nc + (m.position + c).cross(&f);
+    }
+    (force, moment)
+}
+
+#[test]
+fn reactions_balance_the_whole_mechanism() {
+    let model = case("palletizer");
+    let ev = Evaluator::new(&model).unwrap();
+    assert!(
+        ev.reactions.minimum_norm,
+        "the pantograph is overconstrained in space"
+    );
+    let params = ParameterSet::unbalanced(&model);
+    let j1 = model.joint_index("J1").unwrap();
+    let mut rng = SplitMix64::new(11);
+    for _ in 0..6 {
+        let (q, qd, qdd) = random_state(&model, &mut rng);
+        let view = ev.at_state(&q, &qd, &qdd, &params, &[0], true).unwrap();
+        let (force, moment) = inertial_wrench(&model, &q, &qd, &qdd);
+        let r = &view.reactions[0];
+        // Only J1 and the actuator M1 (a torque about Y0 on J1) connect the robot to the base;
+        // J1's point is the world origin.
+        let tau = view.actuator_force[0][0];
+        let f_base = r.force[j1];
+        let m_base = r.moment[j1] + Vector3::y() * tau;
+        let scale = force.norm().max(1.0);
+        assert!(
+            (f_base - force).norm() < 1e-7 * scale,
+            "{f_base} vs {force}"
+        );
+        assert!(
+            (m_base - moment).norm() < 1e-7 * moment.norm().max(scale),
+            "{m_base} vs {moment}"
+        );
+        // a revolute joint carries no moment along its axis
+        assert!(r.moment[j1].y.abs() < 1e-7 * scale);
+    }
+}
+
+#[test]
+fn reversed_task_has_the_same_rms_and_peaks() {
+    let model = case("palletizer");
+    let ev = Evaluator::new(&model).unwrap();
+    let params = ParameterSet::unbalanced(&model);
+    let mut ws = Workspace::default();
+    let a = [0.0, 0.0, 1.03];
+    let b = [2.5, 0.2, 1.3];
+    let c = [1.0, 0.266667, 1.1];
+    for (from, to) in [(a, b), (b, c), (a, c)] {
+        let mut q1 = ev.solve_point(&from).unwrap();
+        let mut q2 = ev.solve_point(&to).unwrap();
+        let fwd = ev
+            .move_stats(&from, &to, 2.5, 51, &mut q1, &params, true, &mut ws)
+            .unwrap();
+        let rev = ev
+            .move_stats(&to, &from, 2.5, 51, &mut q2, &params, true, &mut ws)
+            .unwrap();
+        let (f, r) = (&fwd[0], &rev[0]);
+        let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * (1.0 + x.abs());
+        for i in 0..3 {
+            assert!(
+                close(f.rms[i], r.rms[i]),
+                "rms {i}: {} {}",
+                f.rms[i],
+                r.rms[i]
+            );
+            assert!(close(f.peak[i], r.peak[i]), "peak {i}");
+        }
+        assert!(close(f.total_peak, r.total_peak));
+        for j in 0..f.force_peak.len() {
+            assert!(close(f.force_peak[j], r.force_peak[j]), "F_{j}");
+            assert!(close(f.moment_peak[j], r.moment_peak[j]), "M_{j}");
+        }
+        assert!(f.rms[2] > 1.0, "M3 carries gravity");
+    }
+}
