@@ -511,3 +511,76 @@ fn all_errors_are_collected() {
             .starts_with(&format!("{} errors in the case file", errors.len()))
     );
 }
+
+/// JSON pointers of every value in `v` (objects and arrays included).
+fn pointers(v: &Value, prefix: String, out: &mut Vec<String>) {
+    match v {
+        Value::Object(map) => {
+            for (k, child) in map {
+                pointers(child, format!("{prefix}/{k}"), out);
+            }
+        }
+        Value::Array(items) => {
+            for (i, child) in items.iter().enumerate() {
+                pointers(child, format!("{prefix}/{i}"), out);
+            }
+        }
+        _ => {}
+    }
+    out.push(prefix);
+}
+
+fn odd_values() -> Vec<Value> {
+    vec![
+        json!(-1),
+        json!(0),
+        json!(1e308),
+        json!(-1e-300),
+        json!(""),
+        json!("q1"),
+        json!("base"),
+        json!("link1"),
+        json!("sqrt(2)"),
+        json!("cos(q1)^70"),
+        json!("1/0"),
+        json!([]),
+        json!([0, 0, 0]),
+        json!([1, 0]),
+        json!({}),
+        json!(null),
+        json!(true),
+    ]
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(400))]
+    /// Whatever single field is replaced or removed, loading returns a model or errors: it never
+    /// panics.
+    #[test]
+    fn mutated_cases_never_panic(which in 0usize..10_000, value in 0usize..17, remove in proptest::bool::weighted(0.2)) {
+        let mut v = base();
+        let mut all = Vec::new();
+        pointers(&v, String::new(), &mut all);
+        let pointer = all[which % all.len()].clone();
+        if pointer.is_empty() {
+            return Ok(());
+        }
+        if remove {
+            let (parent, key) = pointer.rsplit_once('/').unwrap();
+            match v.pointer_mut(parent) {
+                Some(Value::Object(map)) => { map.remove(key); }
+                Some(Value::Array(items)) => { items.remove(key.parse::<usize>().unwrap()); }
+                _ => {}
+            }
+        } else {
+            *v.pointer_mut(&pointer).unwrap() = odd_values()[value].clone();
+        }
+        let text = serde_json::to_string(&v).unwrap();
+        if let Err(errors) = Case::from_json_str(&text) {
+            proptest::prop_assert!(!errors.is_empty());
+            for e in &errors {
+                proptest::prop_assert!(!e.path().is_empty());
+            }
+        }
+    }
+}
