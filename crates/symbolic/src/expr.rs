@@ -246,7 +246,10 @@ fn multiply(src: &str, span: Span, a: Value, b: Value) -> Result<Value, ExprErro
         return Ok(a.scale(c));
     }
     match (a, b) {
-        (Value::Poly(p), Value::Poly(q)) => Ok(Value::Poly(&p * &q)),
+        (Value::Poly(p), Value::Poly(q)) => {
+            check_degree(src, span, p.max_power() + q.max_power())?;
+            Ok(Value::Poly(&p * &q))
+        }
         (Value::Affine(_), Value::Affine(_)) => Err(error(
             src,
             span,
@@ -261,7 +264,10 @@ fn power(src: &str, span: Span, a: Value, n: u32) -> Result<Value, ExprError> {
         return Ok(Value::constant(c.powi(n as i32)));
     }
     match a {
-        Value::Poly(p) => Ok(Value::Poly(p.pow(n))),
+        Value::Poly(p) => {
+            check_degree(src, span, p.max_power().saturating_mul(n))?;
+            Ok(Value::Poly(p.pow(n)))
+        }
         Value::Affine(_) if n == 1 => Ok(a),
         Value::Affine(_) => Err(error(
             src,
@@ -269,6 +275,20 @@ fn power(src: &str, span: Span, a: Value, n: u32) -> Result<Value, ExprError> {
             "a power of an angle is not a trigonometric polynomial",
         )),
     }
+}
+
+/// Highest power of one coordinate an expression may reach (monomials store powers in a byte).
+pub const MAX_DEGREE: u32 = 128;
+
+fn check_degree(src: &str, span: Span, degree: u32) -> Result<(), ExprError> {
+    if degree > MAX_DEGREE {
+        return Err(error(
+            src,
+            span,
+            &format!("degree {degree} exceeds the supported {MAX_DEGREE} in one coordinate"),
+        ));
+    }
+    Ok(())
 }
 
 fn to_angle(src: &str, span: Span, value: Value) -> Result<LinearAngle, ExprError> {
@@ -627,5 +647,10 @@ mod tests {
         refused("(th1 + 2", "(");
         refused("2 $ 3", "$");
         refused("1 2", "2");
+        refused(
+            "cos(th1)^64*cos(th1)^64*cos(th1)^64",
+            "cos(th1)^64*cos(th1)^64*cos(th1)^64",
+        );
+        refused("(rho^60)^3", "rho^60");
     }
 }

@@ -226,6 +226,17 @@ impl TrigPoly {
         self.terms.iter().map(|(m, c)| c * at.monomial(m)).sum()
     }
 
+    /// Highest power of any single coordinate (`cos q_k` or `q_k`) in any term.
+    pub fn max_power(&self) -> u32 {
+        self.terms
+            .keys()
+            .flat_map(|m| {
+                (0..MAX_VARS).map(move |k| u32::from(m.power(k)) + u32::from(m.has_sine(k)))
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
     /// Coordinates this polynomial depends on.
     pub fn variables(&self) -> Vec<usize> {
         let mut used = [false; MAX_VARS];
