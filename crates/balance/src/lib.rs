@@ -30,4 +30,4 @@ pub use energy::{BodyFrame, MechanismEnergy};
 pub use model_input::{catalogue_options, mechanism_energy, realization_hints};
 pub use realize::{CounterweightParams, RealizationHints, SpringParams, Witness};
 pub use search::{Class, SearchOptions, SearchReport, Status, VariantResult, decide, search};
-pub use verify::{VERIFY_SAMPLES, VERIFY_TOL, Verification};
+pub use verify::{VERIFY_SAMPLES, VERIFY_TOL, Verification, VerificationSet};

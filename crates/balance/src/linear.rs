@@ -207,11 +207,11 @@ impl LinearSolution {
     pub fn contribution_forced_zero(&self, k: usize, b_norm: f64) -> bool {
         let range = self.element_range(k);
         let a_k = self.matrix.columns(range.start, range.len());
-        let fixed = &a_k * self.particular.rows(range.start, range.len());
+        let fixed = a_k * self.particular.rows(range.start, range.len());
         if fixed.norm() > FIXED_TOL * b_norm {
             return false;
         }
-        let moving = &a_k * self.nullspace.rows(range.start, range.len());
+        let moving = a_k * self.nullspace.rows(range.start, range.len());
         // `A_k N` is in scaled units (unit columns times orthonormal vectors): at most 1.
         moving.iter().all(|v| v.abs() <= FIXED_TOL)
     }

@@ -12,6 +12,8 @@
 //! not positive.
 
 use counterpoise_model::sampling::SplitMix64;
+use std::ops::AddAssign;
+
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
@@ -153,6 +155,7 @@ pub fn realize(
         unknowns += physical_len(&entry.element);
     }
     let problem = Problem {
+        hints,
         matrix: &solution.matrix,
         b,
         slots: &slots,
@@ -164,7 +167,9 @@ pub fn realize(
     let mut best = f64::INFINITY;
     for start in 0..STARTS {
         let y0 = problem.start(solution, hints, start, &mut rng);
-        let (y, residual) = problem.levenberg_marquardt(y0);
+        // First towards a plausible balanced point, then onto the exact balance from there.
+        let (plausible, _) = problem.levenberg_marquardt(y0, PULL);
+        let (y, residual) = problem.levenberg_marquardt(plausible, 0.0);
         best = best.min(residual);
         if residual <= SOLVED_TOL {
             return Realization::Found(problem.witness(&y));
@@ -175,8 +180,15 @@ pub fn realize(
     ))
 }
 
-const STARTS: usize = 24;
-const MAX_ITERATIONS: usize = 400;
+/// Starting points per variant. On the palletizer at Dmax = 3, 1156 of 1167 balanced variants
+/// are realized from the first start and none needed more than four.
+const STARTS: usize = 6;
+const MAX_ITERATIONS: usize = 300;
+/// Iterations in a row that each gain less than 0.1 % before a start is abandoned: such a start
+/// is creeping towards a solution at infinity (a stiffness or mass going to zero or infinity).
+const STALL_ITERATIONS: usize = 25;
+/// Weight of the plausibility rows in the first phase, relative to the balance residual.
+const PULL: f64 = 1e-3;
 /// Relative residual ‖A x(y) + b‖/‖b‖ at which the local search stops; the energy sampling of
 /// the caller is the real check.
 const SOLVED_TOL: f64 = 1e-13;
@@ -190,6 +202,7 @@ fn physical_len(element: &Element) -> usize {
 }
 
 struct Problem<'a> {
+    hints: RealizationHints,
     matrix: &'a DMatrix<f64>,
     b: &'a DVector<f64>,
     slots: &'a [Slot<'a>],
@@ -197,24 +210,43 @@ struct Problem<'a> {
 }
 
 impl Problem<'_> {
-    /// Residual `(A x(y) + b)/‖b‖` and its Jacobian.
-    fn evaluate(&self, y: &DVector<f64>) -> (DVector<f64>, DMatrix<f64>) {
+    /// Residual `(A x(y) + b)/‖b‖` and its Jacobian; with `pull > 0`, extra rows pull every
+    /// mass and stiffness towards its hint and every offset and anchor towards the body origin
+    /// (scaled by the hint length), so that among many solutions a plausible one is found.
+    // Index loops mirror the formulas (a_k, b_l, W_kl) more clearly than zipped iterators.
+    #[allow(clippy::needless_range_loop)]
+    fn evaluate(&self, y: &DVector<f64>, pull: f64) -> (DVector<f64>, DMatrix<f64>) {
         let scale = 1.0 / self.b.norm().max(f64::MIN_POSITIVE);
         let rows = self.matrix.nrows();
-        let mut r = self.b * scale;
-        let mut jac = DMatrix::zeros(rows, self.unknowns);
+        let extra = if pull > 0.0 { self.unknowns } else { 0 };
+        let mut r = DVector::zeros(rows + extra);
+        r.rows_mut(0, rows).copy_from(&(self.b * scale));
+        let mut jac = DMatrix::zeros(rows + extra, self.unknowns);
         for slot in self.slots {
             let col = |j: usize| self.matrix.column(slot.column + j) * scale;
             match &slot.entry.element {
                 Element::Counterweight { axes, .. } => {
                     let m = y[slot.unknown].exp();
                     let dm = col(0) * m;
-                    r += &dm;
-                    jac.set_column(slot.unknown, &dm);
+                    r.rows_mut(0, rows).add_assign(&dm);
+                    jac.view_mut((0, slot.unknown), (rows, 1)).copy_from(&dm);
                     for k in 0..axes.len() {
                         let mu = y[slot.unknown + 1 + k];
-                        r += col(1 + k) * mu;
-                        jac.set_column(slot.unknown + 1 + k, &col(1 + k));
+                        r.rows_mut(0, rows).add_assign(&(col(1 + k) * mu));
+                        jac.view_mut((0, slot.unknown + 1 + k), (rows, 1))
+                            .copy_from(&col(1 + k));
+                    }
+                    if pull > 0.0 {
+                        let row = rows + slot.unknown;
+                        r[row] = pull * (y[slot.unknown] - self.hints.mass.ln());
+                        jac[(row, slot.unknown)] = pull;
+                        for k in 0..axes.len() {
+                            let mu = y[slot.unknown + 1 + k];
+                            let row = rows + slot.unknown + 1 + k;
+                            r[row] = pull * mu / (m * self.hints.length);
+                            jac[(row, slot.unknown)] = -r[row];
+                            jac[(row, slot.unknown + 1 + k)] = pull / (m * self.hints.length);
+                        }
                     }
                 }
                 Element::Spring { axes_a, axes_b, .. } => {
@@ -236,21 +268,34 @@ impl Problem<'_> {
                             unit += col(w(k, l)) * (a[k] * bb[l]);
                         }
                     }
-                    r += &unit * stiffness;
-                    jac.set_column(slot.unknown, &(&unit * stiffness));
+                    r.rows_mut(0, rows).add_assign(&(&unit * stiffness));
+                    jac.view_mut((0, slot.unknown), (rows, 1))
+                        .copy_from(&(&unit * stiffness));
                     for k in 0..na {
                         let mut d = col(1 + k);
                         for l in 0..nb {
                             d += col(w(k, l)) * bb[l];
                         }
-                        jac.set_column(slot.unknown + 1 + k, &(d * stiffness));
+                        jac.view_mut((0, slot.unknown + 1 + k), (rows, 1))
+                            .copy_from(&(d * stiffness));
                     }
                     for l in 0..nb {
                         let mut d = col(1 + na + l);
                         for k in 0..na {
                             d += col(w(k, l)) * a[k];
                         }
-                        jac.set_column(slot.unknown + 1 + na + l, &(d * stiffness));
+                        jac.view_mut((0, slot.unknown + 1 + na + l), (rows, 1))
+                            .copy_from(&(d * stiffness));
+                    }
+                    if pull > 0.0 {
+                        let row = rows + slot.unknown;
+                        r[row] = pull * (y[slot.unknown] - self.hints.stiffness.ln());
+                        jac[(row, slot.unknown)] = pull;
+                        for j in 0..na + nb {
+                            let row = rows + slot.unknown + 1 + j;
+                            r[row] = pull * y[slot.unknown + 1 + j] / self.hints.length;
+                            jac[(row, slot.unknown + 1 + j)] = pull / self.hints.length;
+                        }
                     }
                 }
             }
@@ -302,14 +347,15 @@ impl Problem<'_> {
         y
     }
 
-    /// Damped Gauss–Newton with Marquardt's adaptive damping; returns the point and its relative
-    /// residual.
-    fn levenberg_marquardt(&self, mut y: DVector<f64>) -> (DVector<f64>, f64) {
-        let (mut r, mut jac) = self.evaluate(&y);
+    /// Damped Gauss–Newton with Marquardt's adaptive damping; returns the point and the
+    /// relative balance residual (without the pull rows).
+    fn levenberg_marquardt(&self, mut y: DVector<f64>, pull: f64) -> (DVector<f64>, f64) {
+        let (mut r, mut jac) = self.evaluate(&y, pull);
         let mut cost = r.norm();
         let mut lambda = 1e-3;
+        let mut slow = 0;
         for _ in 0..MAX_ITERATIONS {
-            if cost <= SOLVED_TOL {
+            if cost <= SOLVED_TOL || slow >= STALL_ITERATIONS {
                 break;
             }
             let jtj = jac.transpose() * &jac;
@@ -327,7 +373,7 @@ impl Problem<'_> {
                 let step = chol.solve(&(-&gradient));
                 let mut candidate = &y + &step;
                 self.clamp_logs(&mut candidate);
-                let (r_new, jac_new) = self.evaluate(&candidate);
+                let (r_new, jac_new) = self.evaluate(&candidate, pull);
                 let cost_new = r_new.norm();
                 if cost_new.is_finite() && cost_new < cost {
                     y = candidate;
@@ -337,6 +383,7 @@ impl Problem<'_> {
                     cost = cost_new;
                     lambda = (lambda / 3.0).max(1e-15);
                     improved = relative_gain > 1e-15;
+                    slow = if relative_gain < 1e-3 { slow + 1 } else { 0 };
                     break;
                 }
                 lambda *= 4.0;
@@ -345,7 +392,8 @@ impl Problem<'_> {
                 break;
             }
         }
-        (y, cost)
+        let balance = r.rows(0, self.matrix.nrows()).norm();
+        (y, balance)
     }
 
     fn clamp_logs(&self, y: &mut DVector<f64>) {

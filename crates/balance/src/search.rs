@@ -11,7 +11,7 @@ use crate::enumerate::variants;
 use crate::linear::{LiftedBasis, solve};
 use crate::realize::{Realization, RealizationHints, Witness, realize};
 use crate::relations::{FreeDirection, balance_relations, free_directions, variable_units};
-use crate::verify::{Verification, verify};
+use crate::verify::{Verification, VerificationSet};
 
 /// What the search concluded about a variant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
@@ -144,10 +144,11 @@ pub fn search(
     options: SearchOptions,
 ) -> SearchReport {
     let basis = LiftedBasis::build(energy, &catalogue);
+    let checks = VerificationSet::new(energy);
     let sets: Vec<Vec<usize>> = variants(catalogue.len(), options.dmax).collect();
     let variants = sets
         .par_iter()
-        .map(|set| decide(energy, &catalogue, &basis, set, options.hints))
+        .map(|set| decide(energy, &catalogue, &basis, &checks, set, options.hints))
         .collect();
     SearchReport {
         catalogue,
@@ -160,6 +161,7 @@ pub fn decide(
     energy: &MechanismEnergy,
     catalogue: &Catalogue,
     basis: &LiftedBasis,
+    checks: &VerificationSet,
     set: &[usize],
     hints: RealizationHints,
 ) -> VariantResult {
@@ -227,7 +229,7 @@ pub fn decide(
 
     match realize(&solution, b, &entries, hints) {
         Realization::Found(witness) => {
-            let verification = verify(energy, &witness);
+            let verification = checks.verify(&witness);
             if verification.passed {
                 result.status = Status::Balanced;
             } else {

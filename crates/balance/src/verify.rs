@@ -48,23 +48,88 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// Potential energy of the witness's elements alone at one configuration.
-pub fn element_energy(energy: &MechanismEnergy, witness: &Witness, at: &Point) -> f64 {
+type Pose = ([[f64; 3]; 3], [f64; 3]);
+
+/// The verification configurations with every body pose and the unbalanced energy evaluated
+/// once, shared by all witnesses of a search.
+#[derive(Clone, Debug)]
+pub struct VerificationSet {
+    poses: Vec<Vec<Pose>>,
+    unbalanced: Vec<f64>,
+    gravity: [f64; 3],
+    unbalanced_spread: f64,
+}
+
+impl VerificationSet {
+    /// Samples [`VERIFY_SAMPLES`] configurations (fixed seed) and evaluates the mechanism there.
+    pub fn new(energy: &MechanismEnergy) -> VerificationSet {
+        let mut poses = Vec::with_capacity(VERIFY_SAMPLES);
+        let mut unbalanced = Vec::with_capacity(VERIFY_SAMPLES);
+        for q in sample_configurations(energy, VERIFY_SAMPLES, 0x7e57_0fba_1a5c_e5e5) {
+            let at = Point::new(&q, &energy.kinds);
+            poses.push(
+                (0..energy.bodies.len())
+                    .map(|i| energy.pose(i, &at))
+                    .collect(),
+            );
+            unbalanced.push(energy.unbalanced.eval(&at));
+        }
+        let (lo, hi) = spread(&unbalanced);
+        VerificationSet {
+            poses,
+            unbalanced,
+            gravity: energy.gravity,
+            unbalanced_spread: hi - lo,
+        }
+    }
+
+    /// Samples the witness's total energy over the set.
+    pub fn verify(&self, witness: &Witness) -> Verification {
+        let totals: Vec<f64> = self
+            .poses
+            .iter()
+            .zip(&self.unbalanced)
+            .map(|(poses, v_ub)| v_ub + element_energy(poses, self.gravity, witness))
+            .collect();
+        let (lo, hi) = spread(&totals);
+        let residual = if self.unbalanced_spread > 0.0 {
+            (hi - lo) / self.unbalanced_spread
+        } else {
+            hi - lo
+        };
+        Verification {
+            residual,
+            samples: totals.len(),
+            passed: residual.is_finite() && residual <= VERIFY_TOL,
+        }
+    }
+}
+
+fn spread(values: &[f64]) -> (f64, f64) {
+    values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
+/// Potential energy of the witness's elements alone, given every body's numeric pose.
+pub fn element_energy(poses: &[Pose], gravity: [f64; 3], witness: &Witness) -> f64 {
     let mut total = 0.0;
     for cw in &witness.counterweights {
-        let (r, p) = energy.pose(cw.body, at);
-        let offset = apply(&r, cw.offset);
+        let (r, p) = &poses[cw.body];
+        let offset = apply(r, cw.offset);
         let position = [p[0] + offset[0], p[1] + offset[1], p[2] + offset[2]];
-        total -= cw.mass * dot(energy.gravity, position);
+        total -= cw.mass * dot(gravity, position);
     }
     for spring in &witness.springs {
-        let (r_i, p_i) = energy.pose(spring.body, at);
-        let a = apply(&r_i, spring.anchor_a);
+        let (r_i, p_i) = &poses[spring.body];
+        let a = apply(r_i, spring.anchor_a);
         let b = match spring.other {
             Attachment::Base => spring.anchor_b,
             Attachment::Body(s) => {
-                let (r_s, p_s) = energy.pose(s, at);
-                let b = apply(&r_s, spring.anchor_b);
+                let (r_s, p_s) = &poses[s];
+                let b = apply(r_s, spring.anchor_b);
                 [p_s[0] + b[0], p_s[1] + b[1], p_s[2] + b[2]]
             }
         };
@@ -72,29 +137,4 @@ pub fn element_energy(energy: &MechanismEnergy, witness: &Witness, at: &Point) -
         total += 0.5 * spring.stiffness * dot(d, d);
     }
     total
-}
-
-/// Samples the total energy at [`VERIFY_SAMPLES`] configurations.
-pub fn verify(energy: &MechanismEnergy, witness: &Witness) -> Verification {
-    let mut unbalanced = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut total = (f64::INFINITY, f64::NEG_INFINITY);
-    for q in sample_configurations(energy, VERIFY_SAMPLES, 0x7e57_0f_ba1a_5ce5) {
-        let at = Point::new(&q, &energy.kinds);
-        let v_ub = energy.unbalanced.eval(&at);
-        let v = v_ub + element_energy(energy, witness, &at);
-        unbalanced = (unbalanced.0.min(v_ub), unbalanced.1.max(v_ub));
-        total = (total.0.min(v), total.1.max(v));
-    }
-    let spread_ub = unbalanced.1 - unbalanced.0;
-    let spread = total.1 - total.0;
-    let residual = if spread_ub > 0.0 {
-        spread / spread_ub
-    } else {
-        spread
-    };
-    Verification {
-        residual,
-        samples: VERIFY_SAMPLES,
-        passed: residual.is_finite() && residual <= VERIFY_TOL,
-    }
 }
