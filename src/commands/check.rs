@@ -127,12 +127,14 @@ pub fn summary(model: &Model) -> String {
     }
     let (names, is_angle) = coordinate_names(model);
     let energy = model.potential_energy(PayloadMode::InBalance);
+    let varying = energy.format_with(&names, &is_angle, 2, true);
+    let varying = match varying.strip_prefix('−') {
+        Some(rest) => format!("− {rest}"),
+        None => format!("+ {varying}"),
+    };
     line(
         &mut out,
-        format!(
-            "unbalanced potential energy: V = const + {} J",
-            energy.format_with(&names, &is_angle, 2, true)
-        ),
+        format!("unbalanced potential energy: V = const {varying} J"),
     );
     if let Some(tasks) = &model.tasks {
         out.push_str(&reachability(model, tasks));
