@@ -143,6 +143,10 @@ pub fn realize(
         }
     }
 
+    if let Some(reason) = rank_one_contradiction(solution, entries) {
+        return Realization::Impossible(reason);
+    }
+
     let mut slots = Vec::new();
     let mut unknowns = 0;
     for (k, (entry_index, entry)) in entries.iter().enumerate() {
@@ -168,8 +172,8 @@ pub fn realize(
     for start in 0..STARTS {
         let y0 = problem.start(solution, hints, start, &mut rng);
         // First towards a plausible balanced point, then onto the exact balance from there.
-        let (plausible, _) = problem.levenberg_marquardt(y0, PULL);
-        let (y, residual) = problem.levenberg_marquardt(plausible, 0.0);
+        let (plausible, _) = problem.levenberg_marquardt(y0, PULL, PULL_ITERATIONS);
+        let (y, residual) = problem.levenberg_marquardt(plausible, 0.0, MAX_ITERATIONS);
         best = best.min(residual);
         if residual <= SOLVED_TOL {
             return Realization::Found(problem.witness(&y));
@@ -182,11 +186,134 @@ pub fn realize(
 
 /// Starting points per variant. On the palletizer at Dmax = 3, 1156 of 1167 balanced variants
 /// are realized from the first start and none needed more than four.
+/// Random points of the solution set used to recognise a spring residual as an identity.
+const IDENTITY_SAMPLES: usize = 8;
+
+/// Proves a variant unrealizable when some spring cannot have a rank-one `W = αβᵀ/K`.
+///
+/// For a spring, realizability means `A_W (K·W − α βᵀ) = 0` (only the combinations of `W` that
+/// change the energy matter). Along the solution set `x = x_p + N z` each component of that
+/// residual is a quadratic polynomial in `z`. If it equals `c0 + c1·K(z)` identically — checked at
+/// random points of the solution set, which for a polynomial identity is conclusive with
+/// probability one — and that affine function of `K` has no root with `K > 0`, no spring exists.
+/// This is the palletizer's lone `K42`: balance fixes `a = (1/4, 0)` and `K·b`, so
+/// `K·(a×b)` is a fixed multiple of `K` that differs from the required value for every `K > 0`.
+fn rank_one_contradiction(
+    solution: &LinearSolution,
+    entries: &[(usize, &CatalogueEntry)],
+) -> Option<String> {
+    let mut rng = SplitMix64::new(0x0a4e_0f0e_5a11_0001);
+    let scale = solution
+        .particular
+        .component_mul(&solution.column_scale)
+        .norm()
+        .max(1.0);
+    let points: Vec<DVector<f64>> = (0..IDENTITY_SAMPLES)
+        .map(|_| {
+            let z = DVector::from_fn(solution.nullspace.ncols(), |_, _| {
+                scale * rng.uniform(-1.0, 1.0)
+            });
+            &solution.particular + &solution.nullspace * z
+        })
+        .collect();
+    for (k, (_, entry)) in entries.iter().enumerate() {
+        let Element::Spring { axes_a, axes_b, .. } = &entry.element else {
+            continue;
+        };
+        let (na, nb) = (axes_a.len(), axes_b.len());
+        let start = solution.offsets[k];
+        let w_start = start + 1 + na + nb;
+        let a_w = solution.matrix.columns(w_start, na * nb);
+        let mut stiffness = Vec::with_capacity(points.len());
+        let mut residuals = Vec::with_capacity(points.len());
+        let mut magnitude = 0.0f64;
+        for x in &points {
+            let kk = x[start];
+            let mut mismatch = DVector::zeros(na * nb);
+            let mut outer = DVector::zeros(na * nb);
+            for i in 0..na {
+                for j in 0..nb {
+                    let ab = x[start + 1 + i] * x[start + 1 + na + j];
+                    outer[i * nb + j] = ab;
+                    mismatch[i * nb + j] = kk * x[w_start + i * nb + j] - ab;
+                }
+            }
+            let kw = DVector::from_fn(na * nb, |r, _| kk * x[w_start + r]);
+            magnitude = magnitude.max((&a_w * kw).amax()).max((&a_w * outer).amax());
+            stiffness.push(kk);
+            residuals.push(&a_w * mismatch);
+        }
+        if magnitude == 0.0 {
+            continue;
+        }
+        let tol = 1e-8 * magnitude;
+        for row in 0..a_w.nrows() {
+            let values: Vec<f64> = residuals.iter().map(|r| r[row]).collect();
+            if let Some(reason) =
+                affine_in_stiffness_without_positive_root(&stiffness, &values, tol)
+            {
+                return Some(format!(
+                    "{}: no spring has the anchors balance requires ({reason})",
+                    entry.label
+                ));
+            }
+        }
+    }
+    None
+}
+
+/// Whether `values = c0 + c1·K` exactly over the samples with no root at `K > 0`; the reason.
+fn affine_in_stiffness_without_positive_root(
+    k: &[f64],
+    values: &[f64],
+    tol: f64,
+) -> Option<String> {
+    let n = k.len() as f64;
+    let k_mean = k.iter().sum::<f64>() / n;
+    let v_mean = values.iter().sum::<f64>() / n;
+    let k_var: f64 = k.iter().map(|x| (x - k_mean).powi(2)).sum();
+    let k_span = k.iter().map(|x| (x - k_mean).abs()).fold(0.0, f64::max);
+    let (c0, c1) = if k_span <= 1e-12 * k_mean.abs().max(1.0) {
+        (v_mean, 0.0) // stiffness fixed: the residual must be constant
+    } else {
+        let cov: f64 = k
+            .iter()
+            .zip(values)
+            .map(|(x, v)| (x - k_mean) * (v - v_mean))
+            .sum();
+        let c1 = cov / k_var;
+        (v_mean - c1 * k_mean, c1)
+    };
+    let exact = k
+        .iter()
+        .zip(values)
+        .all(|(x, v)| (c0 + c1 * x - v).abs() <= tol);
+    if !exact {
+        return None;
+    }
+    if c1.abs() * k.iter().fold(0.0f64, |a, x| a.max(x.abs())) <= tol {
+        // constant residual
+        return (c0.abs() > tol).then(|| {
+            format!("a rank-one K·a·bᵀ misses the required value by {c0:.4e} for every K")
+        });
+    }
+    // A root at K = 0 (within rounding) is no spring either: K must be strictly positive.
+    if c0.abs() <= tol {
+        return Some(format!("K·W − α·βᵀ = {c1:.4e}·K vanishes only at K = 0"));
+    }
+    let root = -c0 / c1;
+    (root <= 0.0)
+        .then(|| format!("K·W − α·βᵀ = {c0:.4e} + {c1:.4e}·K vanishes only at K = {root:.4e} ≤ 0"))
+}
+
 const STARTS: usize = 6;
 const MAX_ITERATIONS: usize = 300;
 /// Iterations in a row that each gain less than 0.1 % before a start is abandoned: such a start
 /// is creeping towards a solution at infinity (a stiffness or mass going to zero or infinity).
-const STALL_ITERATIONS: usize = 25;
+const STALL_ITERATIONS: usize = 15;
+/// Iterations of the plausibility phase: enough to settle near a plausible point, which the
+/// second phase then makes exact.
+const PULL_ITERATIONS: usize = 40;
 /// Weight of the plausibility rows in the first phase, relative to the balance residual.
 const PULL: f64 = 1e-3;
 /// Relative residual ‖A x(y) + b‖/‖b‖ at which the local search stops; the energy sampling of
@@ -349,12 +476,17 @@ impl Problem<'_> {
 
     /// Damped Gauss–Newton with Marquardt's adaptive damping; returns the point and the
     /// relative balance residual (without the pull rows).
-    fn levenberg_marquardt(&self, mut y: DVector<f64>, pull: f64) -> (DVector<f64>, f64) {
+    fn levenberg_marquardt(
+        &self,
+        mut y: DVector<f64>,
+        pull: f64,
+        max_iterations: usize,
+    ) -> (DVector<f64>, f64) {
         let (mut r, mut jac) = self.evaluate(&y, pull);
         let mut cost = r.norm();
         let mut lambda = 1e-3;
         let mut slow = 0;
-        for _ in 0..MAX_ITERATIONS {
+        for _ in 0..max_iterations {
             if cost <= SOLVED_TOL || slow >= STALL_ITERATIONS {
                 break;
             }
