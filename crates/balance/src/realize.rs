@@ -239,9 +239,9 @@ fn rank_one_contradiction(
                 }
             }
             let kw = DVector::from_fn(na * nb, |r, _| kk * x[w_start + r]);
-            magnitude = magnitude.max((&a_w * kw).amax()).max((&a_w * outer).amax());
+            magnitude = magnitude.max((a_w * kw).amax()).max((a_w * outer).amax());
             stiffness.push(kk);
-            residuals.push(&a_w * mismatch);
+            residuals.push(a_w * mismatch);
         }
         if magnitude == 0.0 {
             continue;
