@@ -139,6 +139,19 @@ fn the_paper_sets_and_the_single_upper_arm_counterweight_balance() {
     assert!((cw.mass - 672.843375 / (9.81 * 0.3)).abs() < 1e-6, "{cw:?}");
 }
 
+#[test]
+fn a_lone_upper_arm_to_slider_spring_is_proven_unrealizable() {
+    // K42 alone: balance fixes a = (1/4, 0) (the spring's |d|² term), K·b = (0, β_y) and the
+    // required K·(a×b); a rank-one spring then misses K·(a×b) by a fixed multiple of K, which is
+    // exactly the sin θ3 coefficient of V_UB (2830.49 N·m) that the spring would have to cancel.
+    let model = palletizer();
+    let report = run(&model, 1);
+    let k42 = find(&report, &["K42"]);
+    assert_eq!(k42.status, Status::Unrealizable, "{k42:?}");
+    let reason = k42.reason.as_deref().unwrap();
+    assert!(reason.contains("-2.8305e3·K"), "{reason}");
+}
+
 fn polar(r: f64, angle: f64) -> [f64; 3] {
     [r * angle.cos(), r * angle.sin(), 0.0]
 }
