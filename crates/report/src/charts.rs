@@ -1,0 +1,204 @@
+//! Which charts the report shows, built from the results: the Fig. 7-style bars per class, the
+//! torque curves on critical tasks (Fig. 10-style) and the path simulation curves (Figs. 9–10).
+//! Shared by the HTML writer and the tests that count one `<svg>` per chart.
+
+use crate::ranking::Class;
+use crate::results::{PathRun, RunResults};
+use crate::svg::{BarChart, LineChart, LineSeries, PALETTE, bar_chart, line_chart};
+
+/// A rendered chart and the section it belongs to.
+#[derive(Clone, Debug)]
+pub struct Chart {
+    pub section: Section,
+    pub title: String,
+    pub svg: String,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Section {
+    Ranking,
+    Torque,
+    PathStatic,
+    PathDynamic,
+}
+
+/// Colour of a class in every chart.
+pub fn class_color(class: Option<Class>) -> &'static str {
+    match class {
+        None => PALETTE[0],
+        Some(Class::Counterweights) => PALETTE[1],
+        Some(Class::Springs) => PALETTE[2],
+        Some(Class::Hybrid) => PALETTE[3],
+    }
+}
+
+/// Most variants shown in one bar chart (the table lists all of them).
+pub const MAX_BARS: usize = 40;
+
+/// Every chart of the report, in display order.
+pub fn all(r: &RunResults) -> Vec<Chart> {
+    let mut charts = ranking_bars(r);
+    charts.extend(torque(r));
+    if let Some(p) = &r.path {
+        if let Some(run) = &p.static_run {
+            charts.extend(path_charts(
+                r,
+                &p.name,
+                &p.actuators,
+                run,
+                "Static",
+                Section::PathStatic,
+            ));
+        }
+        if let Some(run) = &p.dynamic_run {
+            charts.extend(path_charts(
+                r,
+                &p.name,
+                &p.actuators,
+                run,
+                "Dynamic",
+                Section::PathDynamic,
+            ));
+        }
+    }
+    charts
+}
+
+/// Fig. 7: ΔQTR, ΔQIT, ΔR of each variant of a class, best on the left.
+fn ranking_bars(r: &RunResults) -> Vec<Chart> {
+    let ranked = r.ranked();
+    Class::ALL
+        .iter()
+        .filter_map(|&class| {
+            let mut vs: Vec<_> = ranked.iter().filter(|v| v.class == class).collect();
+            if vs.is_empty() {
+                return None;
+            }
+            vs.sort_by_key(|v| v.class_rank);
+            let shown = vs.len().min(MAX_BARS);
+            let mut title = format!("{} — ranking indicators", class.title());
+            if vs.len() > shown {
+                title.push_str(&format!(" (best {shown} of {})", vs.len()));
+            }
+            let chart = BarChart {
+                title: title.clone(),
+                y_label: "variation vs unbalanced [%]".into(),
+                categories: vs[..shown]
+                    .iter()
+                    .map(|v| (v.name.clone().unwrap_or_default(), v.label()))
+                    .collect(),
+                series: vec![
+                    ("ΔQTR (total RMS torque)".into(), "#0072B2".into()),
+                    ("ΔQIT (total peak torque)".into(), "#56B4E9".into()),
+                    ("ΔR (joint reactions)".into(), "#E69F00".into()),
+                ],
+                values: vs[..shown]
+                    .iter()
+                    .map(|v| {
+                        vec![
+                            v.dqtr.unwrap_or(f64::NAN),
+                            v.dqit.unwrap_or(f64::NAN),
+                            v.dr.unwrap_or(f64::NAN),
+                        ]
+                    })
+                    .collect(),
+                min_width: 560.0,
+                height: 340.0,
+            };
+            Some(Chart {
+                section: Section::Ranking,
+                title,
+                svg: bar_chart(&chart),
+            })
+        })
+        .collect()
+}
+
+fn curve_class(r: &RunResults, variant: Option<usize>) -> Option<Class> {
+    variant.and_then(|id| r.variant(id)).map(|v| v.class)
+}
+
+/// Motor torque of UB and the best variants on the critical tasks.
+fn torque(r: &RunResults) -> Vec<Chart> {
+    r.torque_charts
+        .iter()
+        .map(|c| {
+            let mut title = format!("{} — task {}", c.actuator, crate::format::task(c.task));
+            if !c.critical_for.is_empty() {
+                title.push_str(&format!(" ({})", c.critical_for.join(", ")));
+            }
+            let chart = LineChart {
+                title: title.clone(),
+                x_label: "time [s]".into(),
+                y_label: "motor torque [N·m]".into(),
+                series: c
+                    .curves
+                    .iter()
+                    .map(|curve| LineSeries {
+                        label: curve.label.clone(),
+                        color: class_color(curve_class(r, curve.variant)).into(),
+                        dashed: curve.variant.is_none(),
+                        x: c.t.clone(),
+                        y: curve.values.clone(),
+                    })
+                    .collect(),
+                include_zero: true,
+                width: 580.0,
+                height: 330.0,
+            };
+            Chart {
+                section: Section::Torque,
+                title,
+                svg: line_chart(&chart),
+            }
+        })
+        .collect()
+}
+
+fn path_charts(
+    r: &RunResults,
+    name: &str,
+    actuators: &[String],
+    run: &PathRun,
+    kind: &str,
+    section: Section,
+) -> Vec<Chart> {
+    let x_label = if run.x_unit.is_empty() {
+        run.x_label.clone()
+    } else {
+        format!("{} [{}]", run.x_label, run.x_unit)
+    };
+    actuators
+        .iter()
+        .enumerate()
+        .map(|(a, actuator)| {
+            let title = format!("{kind} torque along {name} — {actuator}");
+            let chart = LineChart {
+                title: title.clone(),
+                x_label: x_label.clone(),
+                y_label: "motor torque [N·m]".into(),
+                series: run
+                    .mechanisms
+                    .iter()
+                    .filter_map(|m| {
+                        Some(LineSeries {
+                            label: m.label.clone(),
+                            color: class_color(curve_class(r, m.variant)).into(),
+                            dashed: m.variant.is_none(),
+                            x: run.x.clone(),
+                            y: m.torques.get(a)?.clone(),
+                        })
+                    })
+                    .collect(),
+                include_zero: true,
+                width: 580.0,
+                height: 330.0,
+            };
+            Chart {
+                section,
+                title,
+                svg: line_chart(&chart),
+            }
+        })
+        .collect()
+}

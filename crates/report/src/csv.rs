@@ -1,0 +1,59 @@
+//! ranking.csv: one row per feasible variant in rank order, for spreadsheets and scripts.
+//! Full precision (Rust's shortest round-trip formatting), SI units, empty fields for values the
+//! optimiser did not report.
+
+use crate::format::csv_field;
+use crate::results::RunResults;
+
+/// Column names, in order.
+pub const HEADER: [&str; 16] = [
+    "rank",
+    "class_rank",
+    "name",
+    "id",
+    "elements",
+    "class",
+    "qtr_nm",
+    "qit_nm",
+    "dqtr_percent",
+    "dqit_percent",
+    "dr_percent",
+    "objective_nm",
+    "gap",
+    "iterations",
+    "verification_residual",
+    "tie_broken_by_label",
+];
+
+/// Renders the CSV (header line included).
+pub fn render(r: &RunResults) -> String {
+    let mut s = HEADER.join(",");
+    s.push('\n');
+    let num = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
+    for v in r.ranked() {
+        let o = v.optimiser.clone().unwrap_or_default();
+        let e = v.evaluation.as_ref();
+        let fields = [
+            v.rank.map(|x| x.to_string()).unwrap_or_default(),
+            v.class_rank.map(|x| x.to_string()).unwrap_or_default(),
+            v.name.clone().unwrap_or_default(),
+            v.id.to_string(),
+            v.label(),
+            v.class.name().to_string(),
+            num(e.map(|e| e.qtr)),
+            num(e.map(|e| e.qit)),
+            num(v.dqtr),
+            num(v.dqit),
+            num(v.dr),
+            num(o.objective),
+            num(o.gap),
+            o.iterations.map(|x| x.to_string()).unwrap_or_default(),
+            num(v.verification_residual),
+            v.tie_broken_by_label.to_string(),
+        ];
+        let line: Vec<String> = fields.iter().map(|f| csv_field(f)).collect();
+        s.push_str(&line.join(","));
+        s.push('\n');
+    }
+    s
+}

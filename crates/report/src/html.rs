@@ -1,0 +1,281 @@
+//! report.html: one self-contained page (inline CSS and SVG, no scripts, fonts or links) that
+//! opens offline. It is written as XHTML-compatible markup (every element closed, attributes
+//! quoted, only XML entities) so that it parses as XML, which the tests check.
+
+use std::fmt::Write;
+
+use crate::charts::{self, Chart, Section};
+use crate::format::{escape_html as esc, value};
+use crate::results::RunResults;
+use crate::tables::{self, Table};
+
+const CSS: &str = r#"
+:root { --ink: #1d2327; --muted: #5f6b73; --line: #d9dee2; --band: #f4f6f8; --accent: #0072B2; }
+* { box-sizing: border-box; }
+body { margin: 0; background: #ffffff; color: var(--ink);
+  font: 14px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, "Helvetica Neue", Arial, sans-serif; }
+main { max-width: 1240px; margin: 0 auto; padding: 24px 28px 64px; }
+header { border-bottom: 3px solid var(--accent); padding-bottom: 12px; margin-bottom: 8px; }
+h1 { font-size: 26px; margin: 0 0 4px; }
+h2 { font-size: 19px; margin: 34px 0 10px; padding-bottom: 4px; border-bottom: 1px solid var(--line); }
+h3 { font-size: 15px; margin: 20px 0 6px; }
+p.sub, p.note, .muted { color: var(--muted); }
+p.note { font-size: 13px; max-width: 900px; }
+table { border-collapse: collapse; margin: 6px 0 14px; font-variant-numeric: tabular-nums; }
+th, td { padding: 4px 10px; border-bottom: 1px solid var(--line); text-align: left; vertical-align: top; }
+th { background: var(--band); font-weight: 600; white-space: nowrap; }
+td.n { text-align: right; white-space: nowrap; }
+tr.g td { border-top: 2px solid #b9c2c9; }
+table.kv th { display: none; }
+table.kv td:first-child { color: var(--muted); padding-right: 18px; }
+.cols { display: flex; flex-wrap: wrap; gap: 8px 40px; align-items: flex-start; }
+.charts { display: flex; flex-wrap: wrap; gap: 18px; }
+.charts figure { margin: 0; border: 1px solid var(--line); border-radius: 4px; padding: 4px; }
+svg.chart { display: block; max-width: 100%; height: auto; }
+ul.rel { margin: 4px 0 10px; padding-left: 20px; }
+ul.rel code { font: 12.5px/1.5 ui-monospace, SFMono-Regular, Menlo, Consolas, monospace; }
+details { margin: 8px 0; }
+summary { cursor: pointer; font-weight: 600; }
+.badge { display: inline-block; padding: 0 6px; border-radius: 3px; font-size: 12px; color: #ffffff; }
+footer { margin-top: 40px; color: var(--muted); font-size: 12px; }
+"#;
+
+/// Renders the whole report.
+pub fn render(r: &RunResults) -> String {
+    let charts = charts::all(r);
+    let m = &r.metadata;
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html xmlns=\"http://www.w3.org/1999/xhtml\" lang=\"en\"><head><meta charset=\"utf-8\"/><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/><title>{} — counterpoise balancing report</title><style>{CSS}</style></head><body><main>",
+        esc(&m.case_name)
+    );
+    let _ = write!(
+        h,
+        "<header><h1>Static balancing report: {}</h1><p class=\"sub\">{} {} · {} · D<sub>max</sub> = {} · {} variants examined</p></header>",
+        esc(&m.case_name),
+        esc(&m.tool),
+        esc(&m.tool_version),
+        esc(&m.date),
+        m.dmax,
+        r.variants.len()
+    );
+    for note in &m.notes {
+        let _ = write!(h, "<p class=\"note\">{}</p>", esc(note));
+    }
+
+    h.push_str("<h2>Summary</h2>");
+    let best = tables::best_per_class(r);
+    if best.rows.is_empty() {
+        h.push_str("<p>No feasible balanced variant was found.</p>");
+    } else {
+        h.push_str(&table(&best, ""));
+        h.push_str(&sign_note(r));
+    }
+    h.push_str("<div class=\"cols\"><div><h3>Run</h3>");
+    h.push_str(&table(&tables::metadata(r), "kv"));
+    h.push_str("</div><div><h3>Timings</h3>");
+    h.push_str(&table(&tables::timings(r), ""));
+    h.push_str("</div><div><h3>Variants by status</h3>");
+    h.push_str(&table(&tables::counts(r), ""));
+    h.push_str("</div></div>");
+
+    h.push_str("<h2>Unbalanced robot (Phase 1)</h2><div class=\"cols\"><div>");
+    h.push_str(&table(&tables::unbalanced_summary(r), ""));
+    h.push_str("</div><div>");
+    h.push_str(&table(&tables::unbalanced_actuators(r), ""));
+    h.push_str("</div><div>");
+    if r.unbalanced.joints.is_empty() {
+        h.push_str(
+            "<p class=\"muted\">Joint reactions were not computed; ΔR is 0 for every variant.</p>",
+        );
+    } else {
+        h.push_str(&table(&tables::unbalanced_joints(r), ""));
+    }
+    h.push_str("</div></div>");
+    if r.unbalanced.reactions_minimum_norm {
+        h.push_str("<p class=\"note\">The mechanism is overconstrained: joint reactions are the minimum-norm solution.</p>");
+    }
+    h.push_str("<p class=\"note\">Tasks are moves between task-grid points, written from→to (grid indices). CRT/CPT: the task with the largest RMS / peak motor torque of each actuator.</p>");
+
+    h.push_str("<h2>Ranking (Phase 3)</h2>");
+    let ranking = tables::ranking(r);
+    if ranking.rows.is_empty() {
+        h.push_str("<p>No feasible variant to rank.</p>");
+    } else {
+        h.push_str(&table(&ranking, ""));
+        h.push_str(&ranking_note(r));
+        push_charts(&mut h, &charts, Section::Ranking);
+        h.push_str("<h3>Optimised parameters (Table 1)</h3>");
+        h.push_str(&table(&tables::parameters(r), ""));
+        h.push_str("<p class=\"note\">Spring: stiffness K, anchor a on the first body and b on the second, as distance and angle in the element's plane (body frames). Counterweight: mass m, offset r and angle φ of its centre of mass in the body frame.</p>");
+    }
+
+    if r.torque_charts.is_empty() {
+        h.push_str("<h2>Torque curves</h2><p class=\"muted\">No torque curves were recorded.</p>");
+    } else {
+        h.push_str("<h2>Motor torques on the critical tasks</h2><p class=\"note\">Unbalanced robot (dashed grey) and the best variant of each class. Blue: counterweights only, green: springs only, orange: hybrid.</p>");
+        push_charts(&mut h, &charts, Section::Torque);
+    }
+
+    if let Some(p) = &r.path {
+        let _ = write!(h, "<h2>Path simulation: {}</h2>", esc(&p.name));
+        if let Some(d) = &p.description {
+            let _ = write!(h, "<p class=\"note\">{}</p>", esc(d));
+        }
+        if !p.table.is_empty() {
+            h.push_str("<h3>Motor torques along the path (Table 2)</h3>");
+            h.push_str(&table(&tables::path_table(p), ""));
+        }
+        if p.static_run.is_some() {
+            h.push_str("<h3>Static torques (Fig. 9)</h3>");
+            push_charts(&mut h, &charts, Section::PathStatic);
+        }
+        if p.dynamic_run.is_some() {
+            h.push_str("<h3>Dynamic torques (Fig. 10)</h3>");
+            push_charts(&mut h, &charts, Section::PathDynamic);
+        }
+    }
+
+    let ranked = r.ranked();
+    if !ranked.is_empty() {
+        h.push_str("<h2>Balance relations</h2><p class=\"note\">What exact balance imposes on each ranked variant's lifted parameters (m, m·r, K, K·a, K·b, K·a·bᵀ), the freedom left inside the balanced family, and the verification of the optimised parameters (relative spread of the total potential energy at random configurations).</p>");
+        for v in &ranked {
+            let _ = write!(
+                h,
+                "<h3>{} <span class=\"badge\" style=\"background:{}\">{}</span></h3>",
+                esc(&v.display_name()),
+                charts::class_color(Some(v.class)),
+                esc(v.class.name())
+            );
+            let lines = tables::relations(v);
+            if lines.is_empty() {
+                h.push_str("<p class=\"muted\">No relations recorded.</p>");
+            } else {
+                h.push_str("<ul class=\"rel\">");
+                for l in lines {
+                    let _ = write!(h, "<li><code>{}</code></li>", esc(&l));
+                }
+                h.push_str("</ul>");
+            }
+            if let Some(res) = v.verification_residual {
+                let _ = write!(
+                    h,
+                    "<p class=\"muted\">Verification residual: {}</p>",
+                    esc(&value(res))
+                );
+            }
+        }
+        let joints = tables::joint_reactions(r);
+        if !joints.rows.is_empty() {
+            h.push_str(
+                "<details><summary>Joint reactions of the ranked variants (ΔR breakdown)</summary>",
+            );
+            h.push_str(&table(&joints, ""));
+            h.push_str("</details>");
+        }
+    }
+
+    let others = tables::not_ranked(r);
+    if !others.rows.is_empty() {
+        let _ = write!(
+            h,
+            "<h2>Other balanced variants</h2><details><summary>{} variants balance the mechanism but were not ranked (reasons)</summary>",
+            others.rows.len()
+        );
+        h.push_str(&table(&others, ""));
+        h.push_str("</details>");
+    }
+
+    let _ = write!(
+        h,
+        "<footer>Generated by {} {} from results.json (schema {}). Method: Martini, Troncossi &amp; Rivola (2019), Eqs. 1–3 and 15–21.</footer></main></body></html>",
+        esc(&m.tool),
+        esc(&m.tool_version),
+        r.schema_version
+    );
+    h.push('\n');
+    h
+}
+
+fn sign_note(r: &RunResults) -> String {
+    let _ = r;
+    "<p class=\"note\">ΔQTR and ΔQIT are percentage variations with respect to the unbalanced robot (Eqs. 15–16): negative means a reduction, −100 % is the best possible. ΔR (Eqs. 17–21) weighs the increases of the joint reactions only, so it is never negative; 0 is best.</p>".to_string()
+}
+
+fn ranking_note(r: &RunResults) -> String {
+    let Some(info) = &r.ranking else {
+        return String::new();
+    };
+    let mut s = format!(
+        "<p class=\"note\">Variants are ordered by ΔQTR, then ΔQIT, then ΔR, each compared at a resolution of {} percentage points (values closer than that tie, so dynamically identical spring-only variants are separated by ΔR). {}. Class rank is the position within the class in this order. SB<i>n</i> names the variant ranked <i>n</i>-th.",
+        info.resolution,
+        esc(&capitalise(&info.tie_break))
+    );
+    if info.tie_groups.is_empty() {
+        s.push_str(" No ranks were decided by the tie-break.");
+    } else {
+        let groups: Vec<String> = info
+            .tie_groups
+            .iter()
+            .map(|g| {
+                g.iter()
+                    .filter_map(|id| r.variant(*id))
+                    .map(|v| v.name.clone().unwrap_or_default())
+                    .collect::<Vec<_>>()
+                    .join(" = ")
+            })
+            .collect();
+        let _ = write!(
+            s,
+            " Tied on all three criteria: {}.",
+            esc(&groups.join("; "))
+        );
+    }
+    s.push_str("</p>");
+    s
+}
+
+fn capitalise(s: &str) -> String {
+    let mut c = s.chars();
+    match c.next() {
+        Some(f) => f.to_uppercase().chain(c).collect(),
+        None => String::new(),
+    }
+}
+
+fn push_charts(h: &mut String, charts: &[Chart], section: Section) {
+    h.push_str("<div class=\"charts\">");
+    for c in charts.iter().filter(|c| c.section == section) {
+        let _ = write!(h, "<figure>{}</figure>", c.svg);
+    }
+    h.push_str("</div>");
+}
+
+/// A table as HTML; `class` is an optional CSS class.
+fn table(t: &Table, class: &str) -> String {
+    let mut s = String::new();
+    if class.is_empty() {
+        s.push_str("<table>");
+    } else {
+        let _ = write!(s, "<table class=\"{class}\">");
+    }
+    s.push_str("<thead><tr>");
+    for head in &t.header {
+        let _ = write!(s, "<th>{}</th>", esc(head));
+    }
+    s.push_str("</tr></thead><tbody>");
+    for (row, &group) in t.rows.iter().zip(&t.group_starts) {
+        s.push_str(if group { "<tr class=\"g\">" } else { "<tr>" });
+        for cell in row {
+            if cell.numeric {
+                let _ = write!(s, "<td class=\"n\">{}</td>", esc(&cell.text));
+            } else {
+                let _ = write!(s, "<td>{}</td>", esc(&cell.text));
+            }
+        }
+        s.push_str("</tr>");
+    }
+    s.push_str("</tbody></table>");
+    s
+}

@@ -1,0 +1,120 @@
+//! report.md: the report's tables in Markdown (GitHub-flavoured pipe tables), for reading in a
+//! terminal, a pull request or a wiki. Charts are in report.html only.
+
+use std::fmt::Write;
+
+use crate::format::{escape_md as esc, fixed};
+use crate::results::RunResults;
+use crate::tables::{self, Table};
+
+/// Renders the Markdown report.
+pub fn render(r: &RunResults) -> String {
+    let m = &r.metadata;
+    let mut s = String::new();
+    let _ = writeln!(s, "# Static balancing report: {}\n", esc(&m.case_name));
+    let _ = writeln!(
+        s,
+        "{} {} · {} · Dmax = {} · {} variants examined\n",
+        esc(&m.tool),
+        esc(&m.tool_version),
+        esc(&m.date),
+        m.dmax,
+        r.variants.len()
+    );
+    for note in &m.notes {
+        let _ = writeln!(s, "> {}\n", esc(note));
+    }
+    section(&mut s, "Summary", &tables::best_per_class(r));
+    s.push_str(
+        "ΔQTR and ΔQIT are percentage variations with respect to the unbalanced robot \
+         (negative = reduction, −100 % best); ΔR weighs joint-reaction increases only (≥ 0, 0 best).\n\n",
+    );
+    section(&mut s, "Run", &tables::metadata(r));
+    section(&mut s, "Timings", &tables::timings(r));
+    section(&mut s, "Variants by status", &tables::counts(r));
+    section(&mut s, "Unbalanced robot", &tables::unbalanced_summary(r));
+    table(&mut s, &tables::unbalanced_actuators(r));
+    if !r.unbalanced.joints.is_empty() {
+        table(&mut s, &tables::unbalanced_joints(r));
+    }
+    section(&mut s, "Ranking", &tables::ranking(r));
+    if let Some(info) = &r.ranking {
+        let _ = writeln!(
+            s,
+            "Lexicographic by ΔQTR, ΔQIT, ΔR at a resolution of {} percentage points. {}.\n",
+            fixed(info.resolution, 4)
+                .trim_end_matches('0')
+                .trim_end_matches('.'),
+            esc(&info.tie_break)
+        );
+    }
+    section(
+        &mut s,
+        "Optimised parameters (Table 1)",
+        &tables::parameters(r),
+    );
+    if let Some(p) = r.path.as_ref().filter(|p| !p.table.is_empty()) {
+        section(
+            &mut s,
+            &format!("Path simulation: {}", esc(&p.name)),
+            &tables::path_table(p),
+        );
+    }
+    let ranked = r.ranked();
+    if !ranked.is_empty() {
+        s.push_str("## Balance relations\n\n");
+        for v in ranked {
+            let _ = writeln!(s, "### {} — {}\n", esc(&v.display_name()), v.class.name());
+            for line in tables::relations(v) {
+                let _ = writeln!(s, "- `{}`", line.replace('`', "'"));
+            }
+            if let Some(res) = v.verification_residual {
+                let _ = writeln!(s, "- verification residual: {res:.2e}");
+            }
+            s.push('\n');
+        }
+        section(
+            &mut s,
+            "Joint reactions of the ranked variants",
+            &tables::joint_reactions(r),
+        );
+    }
+    let others = tables::not_ranked(r);
+    if !others.rows.is_empty() {
+        section(&mut s, "Other balanced variants (not ranked)", &others);
+    }
+    s
+}
+
+fn section(s: &mut String, title: &str, t: &Table) {
+    let _ = writeln!(s, "## {title}\n");
+    if t.rows.is_empty() {
+        s.push_str("(none)\n\n");
+    } else {
+        table(s, t);
+    }
+}
+
+/// A pipe table; numeric columns right-aligned.
+fn table(s: &mut String, t: &Table) {
+    let numeric: Vec<bool> = (0..t.header.len())
+        .map(|c| t.rows.iter().any(|r| r[c].numeric))
+        .collect();
+    s.push('|');
+    for h in &t.header {
+        let _ = write!(s, " {} |", esc(h));
+    }
+    s.push_str("\n|");
+    for &n in &numeric {
+        s.push_str(if n { " ---: |" } else { " --- |" });
+    }
+    s.push('\n');
+    for row in &t.rows {
+        s.push('|');
+        for c in row {
+            let _ = write!(s, " {} |", esc(&c.text));
+        }
+        s.push('\n');
+    }
+    s.push('\n');
+}

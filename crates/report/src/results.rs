@@ -1,0 +1,709 @@
+//! The results document (`results.json`): a versioned, self-describing record of a run that the
+//! reports are rendered from, so `counterpoise report DIR` can rebuild them without the case.
+//!
+//! The caller (the `run` command) fills a [`RunResults`] with what the earlier phases produced —
+//! metadata, the case echo, the unbalanced indicators, every variant examined with its status and,
+//! for feasible ones, physical parameters and re-evaluated indicators, then torque curves and an
+//! optional path simulation — and calls [`RunResults::finalize`], which computes the Phase 3
+//! fields (ΔQTR, ΔQIT, ΔR, ranks, counts, tables). `finalize` is idempotent: call it, ask
+//! [`RunResults::best_per_class`] which variants need torque curves, add them, call it again.
+//!
+//! Units are SI throughout the document (kg, m, N/m, N, N·m, s, rad); the reports convert to
+//! the paper's display units (mm, N/mm). Changes that rename or remove fields bump
+//! [`SCHEMA_VERSION`]; see `docs/results-schema.md`.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::indicators::{DeltaR, IndicatorError, JointReaction, delta_r, percent_variation};
+use crate::ranking::{Class, RankItem, RankingError, RankingOptions, rank};
+
+/// Version of the results.json layout.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// A task: the move between two grid points, `[from, to]` (grid indices, as in the dynamics
+/// crate).
+pub type TaskRef = [usize; 2];
+
+/// Why results cannot be finalised.
+#[derive(Debug, Error)]
+pub enum ResultsError {
+    #[error("variant {id} ({label}) is feasible but has no evaluation")]
+    MissingEvaluation { id: usize, label: String },
+    #[error("variant {id} ({label}): {source}")]
+    Indicator {
+        id: usize,
+        label: String,
+        #[source]
+        source: IndicatorError,
+    },
+    #[error(transparent)]
+    Ranking(#[from] RankingError),
+    #[error("path simulation {name}: {what}")]
+    Path { name: String, what: String },
+}
+
+/// What became of a variant (the search's and the optimiser's verdicts combined).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum VariantStatus {
+    /// Balanced, optimised within bounds and re-evaluated: ranked.
+    Feasible,
+    /// Balanced, but the optimiser found no parameters within the bounds/peak limits.
+    Discarded,
+    /// Balanced in lifted parameters, but no physical parameters exist.
+    Unrealizable,
+    /// Balance forces an element to vanish: really a smaller variant.
+    Degenerate,
+    /// The search or the optimiser could not decide.
+    Undecided,
+    /// No parameters balance it.
+    Infeasible,
+}
+
+impl VariantStatus {
+    pub const ALL: [VariantStatus; 6] = [
+        VariantStatus::Feasible,
+        VariantStatus::Discarded,
+        VariantStatus::Unrealizable,
+        VariantStatus::Degenerate,
+        VariantStatus::Undecided,
+        VariantStatus::Infeasible,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            VariantStatus::Feasible => "feasible",
+            VariantStatus::Discarded => "discarded",
+            VariantStatus::Unrealizable => "unrealizable",
+            VariantStatus::Degenerate => "degenerate",
+            VariantStatus::Undecided => "undecided",
+            VariantStatus::Infeasible => "infeasible",
+        }
+    }
+
+    /// One line for the counts table.
+    pub fn meaning(self) -> &'static str {
+        match self {
+            VariantStatus::Feasible => "balanced exactly, parameters within bounds; ranked",
+            VariantStatus::Discarded => {
+                "balanced, but no parameters satisfy the bounds and peak limits"
+            }
+            VariantStatus::Unrealizable => {
+                "balanced in lifted parameters, no physical parameters exist"
+            }
+            VariantStatus::Degenerate => "balance forces an element to vanish (a smaller variant)",
+            VariantStatus::Undecided => "the search or optimiser could not decide",
+            VariantStatus::Infeasible => "no parameters balance the mechanism",
+        }
+    }
+}
+
+/// Plane in which a counterweight offset or spring anchor lies, for polar display (Table 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Plane {
+    Xy,
+    Yz,
+    Zx,
+}
+
+impl Plane {
+    /// Indices of the (first, second) axes: the angle is atan2(second, first).
+    pub fn axes(self) -> (usize, usize) {
+        match self {
+            Plane::Xy => (0, 1),
+            Plane::Yz => (1, 2),
+            Plane::Zx => (2, 0),
+        }
+    }
+}
+
+/// `counterweight` or `spring`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ElementKind {
+    Counterweight,
+    Spring,
+}
+
+/// One installed element of a variant.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ElementInfo {
+    /// Catalogue label, e.g. `m4` or `K43`.
+    pub label: String,
+    #[serde(rename = "type")]
+    pub kind: ElementKind,
+    /// Body names: one for a counterweight, two for a spring (`base` for the ground).
+    pub bodies: Vec<String>,
+}
+
+/// Physical parameters of a counterweight.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CounterweightParams {
+    pub label: String,
+    pub body: String,
+    /// kg.
+    pub mass: f64,
+    /// Centre of mass in the body frame, m.
+    pub offset: [f64; 3],
+    /// Plane of the offset, when the case restricts it to one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane: Option<Plane>,
+}
+
+/// Physical parameters of a zero-free-length spring.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpringParams {
+    pub label: String,
+    /// Body carrying anchor `a`.
+    pub body: String,
+    /// Body carrying anchor `b` (`base` for the ground).
+    pub other: String,
+    /// N/m.
+    pub stiffness: f64,
+    /// Anchor on `body`, in its frame, m.
+    pub anchor_a: [f64; 3],
+    /// Anchor on `other`, in its frame, m.
+    pub anchor_b: [f64; 3],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane: Option<Plane>,
+}
+
+/// The physical parameters of a variant.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PhysicalParameters {
+    pub counterweights: Vec<CounterweightParams>,
+    pub springs: Vec<SpringParams>,
+}
+
+/// One free direction of the balanced family (lifted variable → component).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FreeDirection {
+    pub components: Vec<(String, f64)>,
+    /// Interval of the step along the direction keeping masses and stiffnesses positive
+    /// (`None` bound = unbounded on that side).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub positive_interval: Option<(Option<f64>, Option<f64>)>,
+}
+
+/// RMS and peak motor torque of one actuator on its critical tasks.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ActuatorSummary {
+    pub name: String,
+    /// Critical RMS task and its RMS motor torque, N·m.
+    pub crt: TaskRef,
+    pub crt_rms: f64,
+    /// Critical peak task and its peak |motor torque|, N·m.
+    pub cpt: TaskRef,
+    pub cpt_peak: f64,
+}
+
+/// Peak joint reactions with the tasks where they occur (Eq. 3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JointPeak {
+    pub name: String,
+    /// `F_j`, N.
+    pub force: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_task: Option<TaskRef>,
+    /// `M_j`, N·m.
+    pub moment: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moment_task: Option<TaskRef>,
+}
+
+/// Indicators of one mechanism (the unbalanced robot or a variant) over all tasks (Eqs. 1–3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Evaluation {
+    /// Eq. 1, N·m, and the task where the maximum occurs.
+    pub qtr: f64,
+    pub qtr_task: TaskRef,
+    /// Eq. 2, N·m.
+    pub qit: f64,
+    pub qit_task: TaskRef,
+    pub actuators: Vec<ActuatorSummary>,
+    /// Empty when joint reactions were not computed.
+    pub joints: Vec<JointPeak>,
+    /// Tasks evaluated and tasks excluded (e.g. singular configurations on the way).
+    pub tasks: usize,
+    pub excluded_tasks: usize,
+    /// Joint reactions are minimum-norm (overconstrained mechanism).
+    #[serde(default)]
+    pub reactions_minimum_norm: bool,
+}
+
+impl Evaluation {
+    fn reactions(&self) -> Vec<JointReaction> {
+        self.joints
+            .iter()
+            .map(|j| JointReaction {
+                name: j.name.clone(),
+                force: j.force,
+                moment: j.moment,
+            })
+            .collect()
+    }
+}
+
+/// What the optimiser reports about a variant (all optional: not every optimiser has each).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct OptimiserInfo {
+    /// Objective value (Eq. 11, N·m) at the returned parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub objective: Option<f64>,
+    /// Certified lower bound from the convex relaxation, N·m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower_bound: Option<f64>,
+    /// Relative gap between objective and lower bound.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gap: Option<f64>,
+    /// Critical-task iterations (Proc-5…8).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub iterations: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub message: Option<String>,
+}
+
+/// Every variant examined.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VariantRecord {
+    /// Enumeration index (stable for a case and Dmax).
+    pub id: usize,
+    pub elements: Vec<ElementInfo>,
+    pub class: Class,
+    pub status: VariantStatus,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// Balance relations in readable form (balanced variants).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub relations: Vec<String>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub free_directions: Vec<FreeDirection>,
+    /// Relative spread of the total potential energy at random configurations.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verification_residual: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parameters: Option<PhysicalParameters>,
+    /// Re-evaluation over all tasks with the optimised parameters (feasible variants).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub evaluation: Option<Evaluation>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub optimiser: Option<OptimiserInfo>,
+    // ---- Phase 3, filled by `finalize` for feasible variants ----
+    /// Display name `SB<rank>` (SB1 = best overall).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Eq. 15, percent (negative = reduction = better).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dqtr: Option<f64>,
+    /// Eq. 16, percent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dqit: Option<f64>,
+    /// Eq. 19, percent (≥ 0, lower is better).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dr: Option<f64>,
+    /// Per-joint breakdown of ΔR.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dr_terms: Option<DeltaR>,
+    /// Global and per-class rank, 1 = best.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rank: Option<usize>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub class_rank: Option<usize>,
+    /// True when the rank was decided by the element labels (tied on all three criteria).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub tie_broken_by_label: bool,
+}
+
+impl VariantRecord {
+    /// A record with only the search's fields; the rest default to empty.
+    pub fn new(id: usize, elements: Vec<ElementInfo>, class: Class, status: VariantStatus) -> Self {
+        VariantRecord {
+            id,
+            elements,
+            class,
+            status,
+            reason: None,
+            relations: Vec::new(),
+            free_directions: Vec::new(),
+            verification_residual: None,
+            parameters: None,
+            evaluation: None,
+            optimiser: None,
+            name: None,
+            dqtr: None,
+            dqit: None,
+            dr: None,
+            dr_terms: None,
+            rank: None,
+            class_rank: None,
+            tie_broken_by_label: false,
+        }
+    }
+
+    /// Element labels joined, e.g. `m4 + K43` (also the final ranking tie-break).
+    pub fn label(&self) -> String {
+        self.elements
+            .iter()
+            .map(|e| e.label.as_str())
+            .collect::<Vec<_>>()
+            .join(" + ")
+    }
+
+    /// `SB3 (m4 + K43)` when ranked, else the labels.
+    pub fn display_name(&self) -> String {
+        match &self.name {
+            Some(n) => format!("{n} ({})", self.label()),
+            None => self.label(),
+        }
+    }
+}
+
+/// Wall time of one phase.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PhaseTiming {
+    pub phase: String,
+    pub seconds: f64,
+}
+
+/// Who ran what, when, and how long it took.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunMetadata {
+    /// `counterpoise` and its version.
+    pub tool: String,
+    pub tool_version: String,
+    pub case_name: String,
+    pub case_path: String,
+    pub dmax: usize,
+    /// Worker threads (results do not depend on it).
+    pub jobs: usize,
+    /// Timestamp supplied by the caller (e.g. RFC 3339, UTC); kept verbatim.
+    pub date: String,
+    pub timings: Vec<PhaseTiming>,
+    /// Anything else the designer should know (e.g. "reactions are minimum-norm").
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+}
+
+/// Number of variants with one status, per class.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StatusCount {
+    pub status: VariantStatus,
+    pub counterweights: usize,
+    pub springs: usize,
+    pub hybrid: usize,
+    pub total: usize,
+}
+
+/// How the ranking was made (stated in the reports).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RankingInfo {
+    pub resolution: f64,
+    pub criteria: Vec<String>,
+    pub tie_break: String,
+    /// Variant ids tied on all three criteria, in rank order.
+    pub tie_groups: Vec<Vec<usize>>,
+}
+
+/// One curve of a chart: a mechanism's values on a shared abscissa.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Curve {
+    /// `UB` or the variant's display name.
+    pub label: String,
+    /// Variant id, `None` for the unbalanced robot.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant: Option<usize>,
+    pub values: Vec<f64>,
+}
+
+/// Motor torque of one actuator along one task for several mechanisms (Fig. 10-style).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TorqueChart {
+    pub actuator: String,
+    pub task: TaskRef,
+    /// Why this task is shown, e.g. `["CRT of UB", "CPT of UB"]`.
+    pub critical_for: Vec<String>,
+    /// Time, s.
+    pub t: Vec<f64>,
+    /// Motor torque, N·m, one curve per mechanism (UB first).
+    pub curves: Vec<Curve>,
+}
+
+/// Torques of several mechanisms along a path, per actuator.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PathRun {
+    /// Abscissa label and unit, e.g. ("time", "s") or ("path point", "").
+    pub x_label: String,
+    pub x_unit: String,
+    pub x: Vec<f64>,
+    /// For each mechanism (UB first), motor torque per actuator: `torques[actuator][sample]`.
+    pub mechanisms: Vec<PathMechanism>,
+}
+
+/// One mechanism's motor torques along a path.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PathMechanism {
+    pub label: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant: Option<usize>,
+    /// N·m, `[actuator][sample]`.
+    pub torques: Vec<Vec<f64>>,
+}
+
+/// One row of the Table 2-style statistics: RMS and |peak| of one actuator for one mechanism.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PathStat {
+    pub actuator: String,
+    pub mechanism: String,
+    /// N·m.
+    pub rms: f64,
+    pub peak: f64,
+    /// Percent variation vs the unbalanced robot (`None` for UB itself or a zero reference).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_variation: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_variation: Option<f64>,
+}
+
+/// The paper's Sec. 3.3 simulation: static and dynamic motor torques along a named path.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PathSimulation {
+    pub name: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub description: Option<String>,
+    pub actuators: Vec<String>,
+    /// Static torques (velocities and accelerations zero) along the path.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub static_run: Option<PathRun>,
+    /// The timed cycle (Fig. 10).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dynamic_run: Option<PathRun>,
+    /// Table 2 of the dynamic run, filled by `finalize`.
+    #[serde(default)]
+    pub table: Vec<PathStat>,
+}
+
+/// The whole results document.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunResults {
+    pub schema_version: u32,
+    pub metadata: RunMetadata,
+    /// The case file as read (JSON).
+    pub case: serde_json::Value,
+    /// Phase 1: the unbalanced robot.
+    pub unbalanced: Evaluation,
+    /// Every variant examined, in enumeration order.
+    pub variants: Vec<VariantRecord>,
+    /// Filled by `finalize`.
+    #[serde(default)]
+    pub counts: Vec<StatusCount>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ranking: Option<RankingInfo>,
+    #[serde(default)]
+    pub torque_charts: Vec<TorqueChart>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<PathSimulation>,
+}
+
+impl RunResults {
+    /// A document with the current schema version and no variants, charts or path yet.
+    pub fn new(metadata: RunMetadata, case: serde_json::Value, unbalanced: Evaluation) -> Self {
+        RunResults {
+            schema_version: SCHEMA_VERSION,
+            metadata,
+            case,
+            unbalanced,
+            variants: Vec::new(),
+            counts: Vec::new(),
+            ranking: None,
+            torque_charts: Vec::new(),
+            path: None,
+        }
+    }
+
+    /// Computes counts, ΔQTR/ΔQIT/ΔR, ranks, names and the path table. Idempotent.
+    pub fn finalize(&mut self, options: &RankingOptions) -> Result<(), ResultsError> {
+        self.counts = count_statuses(&self.variants);
+        let ub_joints = self.unbalanced.reactions();
+        let mut items = Vec::new();
+        let mut ranked = Vec::new();
+        for (index, v) in self.variants.iter_mut().enumerate() {
+            v.name = None;
+            v.dqtr = None;
+            v.dqit = None;
+            v.dr = None;
+            v.dr_terms = None;
+            v.rank = None;
+            v.class_rank = None;
+            v.tie_broken_by_label = false;
+            if v.status != VariantStatus::Feasible {
+                continue;
+            }
+            let label = v.label();
+            let wrap = |source| ResultsError::Indicator {
+                id: v.id,
+                label: label.clone(),
+                source,
+            };
+            let Some(eval) = &v.evaluation else {
+                return Err(ResultsError::MissingEvaluation { id: v.id, label });
+            };
+            let dqtr = percent_variation(eval.qtr, self.unbalanced.qtr, "QTR").map_err(wrap)?;
+            let dqit = percent_variation(eval.qit, self.unbalanced.qit, "QIT").map_err(wrap)?;
+            let dr = delta_r(&ub_joints, &eval.reactions()).map_err(wrap)?;
+            items.push(RankItem {
+                key: label,
+                class: v.class,
+                dqtr,
+                dqit,
+                dr: dr.value,
+            });
+            v.dqtr = Some(dqtr);
+            v.dqit = Some(dqit);
+            v.dr = Some(dr.value);
+            v.dr_terms = Some(dr);
+            ranked.push(index);
+        }
+        let ranking = rank(&items, options)?;
+        for (k, &index) in ranked.iter().enumerate() {
+            let v = &mut self.variants[index];
+            v.rank = Some(ranking.rank[k]);
+            v.class_rank = Some(ranking.class_rank[k]);
+            v.name = Some(format!("SB{}", ranking.rank[k]));
+        }
+        for group in &ranking.tie_groups {
+            for &k in group {
+                self.variants[ranked[k]].tie_broken_by_label = true;
+            }
+        }
+        self.ranking = Some(RankingInfo {
+            resolution: options.resolution,
+            criteria: vec!["dqtr".into(), "dqit".into(), "dr".into()],
+            tie_break: "variants tied on all three criteria at the resolution are ordered by \
+                        their element labels (ascending), then by enumeration index"
+                .into(),
+            tie_groups: ranking
+                .tie_groups
+                .iter()
+                .map(|g| g.iter().map(|&k| self.variants[ranked[k]].id).collect())
+                .collect(),
+        });
+        if let Some(path) = &mut self.path {
+            path.table = match &path.dynamic_run {
+                Some(run) => path_table(&path.name, &path.actuators, run)?,
+                None => Vec::new(),
+            };
+        }
+        Ok(())
+    }
+
+    /// Feasible variants in global rank order (after `finalize`).
+    pub fn ranked(&self) -> Vec<&VariantRecord> {
+        let mut v: Vec<&VariantRecord> =
+            self.variants.iter().filter(|v| v.rank.is_some()).collect();
+        v.sort_by_key(|v| v.rank);
+        v
+    }
+
+    /// The best variant of each class that has one (after `finalize`), in class order.
+    pub fn best_per_class(&self) -> Vec<&VariantRecord> {
+        Class::ALL
+            .iter()
+            .filter_map(|&c| {
+                self.variants
+                    .iter()
+                    .find(|v| v.class == c && v.class_rank == Some(1))
+            })
+            .collect()
+    }
+
+    /// Look a variant up by id.
+    pub fn variant(&self, id: usize) -> Option<&VariantRecord> {
+        self.variants.iter().find(|v| v.id == id)
+    }
+}
+
+fn count_statuses(variants: &[VariantRecord]) -> Vec<StatusCount> {
+    let mut map: BTreeMap<VariantStatus, [usize; 3]> = BTreeMap::new();
+    for v in variants {
+        let c = Class::ALL.iter().position(|&c| c == v.class).unwrap_or(0);
+        map.entry(v.status).or_default()[c] += 1;
+    }
+    VariantStatus::ALL
+        .iter()
+        .map(|&status| {
+            let n = map.get(&status).copied().unwrap_or_default();
+            StatusCount {
+                status,
+                counterweights: n[0],
+                springs: n[1],
+                hybrid: n[2],
+                total: n.iter().sum(),
+            }
+        })
+        .collect()
+}
+
+/// RMS (`sqrt(mean τ²)`, all samples equally weighted, as in the dynamics crate) and |peak|.
+pub fn rms_peak(values: &[f64]) -> (f64, f64) {
+    if values.is_empty() {
+        return (0.0, 0.0);
+    }
+    let sum_sq: f64 = values.iter().map(|v| v * v).sum();
+    let peak = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    ((sum_sq / values.len() as f64).sqrt(), peak)
+}
+
+/// Table 2: per actuator, per mechanism, RMS and |peak| with variations vs the first mechanism
+/// (the unbalanced robot).
+pub fn path_table(
+    name: &str,
+    actuators: &[String],
+    run: &PathRun,
+) -> Result<Vec<PathStat>, ResultsError> {
+    let bad = |what: String| ResultsError::Path {
+        name: name.to_string(),
+        what,
+    };
+    for m in &run.mechanisms {
+        if m.torques.len() != actuators.len() {
+            return Err(bad(format!(
+                "{} has {} torque series for {} actuators",
+                m.label,
+                m.torques.len(),
+                actuators.len()
+            )));
+        }
+        if let Some(s) = m.torques.iter().find(|s| s.len() != run.x.len()) {
+            return Err(bad(format!(
+                "{} has a series of {} samples, the abscissa has {}",
+                m.label,
+                s.len(),
+                run.x.len()
+            )));
+        }
+    }
+    let mut rows = Vec::new();
+    for (a, actuator) in actuators.iter().enumerate() {
+        let reference = run.mechanisms.first().map(|m| rms_peak(&m.torques[a]));
+        for (k, m) in run.mechanisms.iter().enumerate() {
+            let (rms, peak) = rms_peak(&m.torques[a]);
+            let variation = |value: f64, reference: f64| {
+                (k > 0 && reference > 0.0).then(|| (value - reference) / reference * 100.0)
+            };
+            let (ref_rms, ref_peak) = reference.unwrap_or((0.0, 0.0));
+            rows.push(PathStat {
+                actuator: actuator.clone(),
+                mechanism: m.label.clone(),
+                rms,
+                peak,
+                rms_variation: variation(rms, ref_rms),
+                peak_variation: variation(peak, ref_peak),
+            });
+        }
+    }
+    Ok(rows)
+}

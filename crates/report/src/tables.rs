@@ -1,0 +1,506 @@
+//! The report's tables as plain data, built once and rendered by both the HTML and the Markdown
+//! writers, so the two reports can never disagree on a number.
+
+use crate::format::{angle, fixed, percent, polar, seconds, task, value};
+use crate::results::{PathSimulation, RunResults, VariantRecord, VariantStatus};
+
+/// One cell: text, and whether it is a number (right-aligned).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cell {
+    pub text: String,
+    pub numeric: bool,
+}
+
+impl Cell {
+    pub fn text(s: impl Into<String>) -> Cell {
+        Cell {
+            text: s.into(),
+            numeric: false,
+        }
+    }
+    pub fn num(s: impl Into<String>) -> Cell {
+        Cell {
+            text: s.into(),
+            numeric: true,
+        }
+    }
+    pub fn empty() -> Cell {
+        Cell::text("")
+    }
+}
+
+/// A table: header, rows, and which rows start a visual group (e.g. a new variant).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<Cell>>,
+    pub group_starts: Vec<bool>,
+}
+
+impl Table {
+    fn new(header: &[&str]) -> Table {
+        Table {
+            header: header.iter().map(|s| s.to_string()).collect(),
+            rows: Vec::new(),
+            group_starts: Vec::new(),
+        }
+    }
+    fn push(&mut self, row: Vec<Cell>, group_start: bool) {
+        debug_assert_eq!(row.len(), self.header.len());
+        self.rows.push(row);
+        self.group_starts.push(group_start);
+    }
+}
+
+/// Run metadata as key/value rows.
+pub fn metadata(r: &RunResults) -> Table {
+    let m = &r.metadata;
+    let mut t = Table::new(&["", ""]);
+    let examined = r.variants.len().to_string();
+    let total: f64 = m.timings.iter().map(|p| p.seconds).sum();
+    for (k, v) in [
+        ("Case", m.case_name.clone()),
+        ("Case file", m.case_path.clone()),
+        ("Date", m.date.clone()),
+        ("Tool", format!("{} {}", m.tool, m.tool_version)),
+        ("Dmax", m.dmax.to_string()),
+        ("Worker threads", m.jobs.to_string()),
+        ("Variants examined", examined),
+        ("Wall time", format!("{} s", seconds(total))),
+        ("Schema version", r.schema_version.to_string()),
+    ] {
+        t.push(vec![Cell::text(k), Cell::text(v)], false);
+    }
+    t
+}
+
+/// Wall time per phase.
+pub fn timings(r: &RunResults) -> Table {
+    let mut t = Table::new(&["Phase", "Time [s]"]);
+    for p in &r.metadata.timings {
+        t.push(
+            vec![Cell::text(&p.phase), Cell::num(seconds(p.seconds))],
+            false,
+        );
+    }
+    t
+}
+
+/// Phase 1 summary.
+pub fn unbalanced_summary(r: &RunResults) -> Table {
+    let u = &r.unbalanced;
+    let mut t = Table::new(&["Indicator", "Value", "Task"]);
+    t.push(
+        vec![
+            Cell::text("QTR (Eq. 1) [N·m]"),
+            Cell::num(value(u.qtr)),
+            Cell::text(task(u.qtr_task)),
+        ],
+        false,
+    );
+    t.push(
+        vec![
+            Cell::text("QIT (Eq. 2) [N·m]"),
+            Cell::num(value(u.qit)),
+            Cell::text(task(u.qit_task)),
+        ],
+        false,
+    );
+    t.push(
+        vec![
+            Cell::text("Tasks evaluated"),
+            Cell::num(u.tasks.to_string()),
+            Cell::empty(),
+        ],
+        false,
+    );
+    t.push(
+        vec![
+            Cell::text("Tasks excluded"),
+            Cell::num(u.excluded_tasks.to_string()),
+            Cell::empty(),
+        ],
+        false,
+    );
+    t
+}
+
+/// Per-actuator RMS and peak on the critical tasks of the unbalanced robot.
+pub fn unbalanced_actuators(r: &RunResults) -> Table {
+    let mut t = Table::new(&["Actuator", "CRT", "RMS [N·m]", "CPT", "|peak| [N·m]"]);
+    for a in &r.unbalanced.actuators {
+        t.push(
+            vec![
+                Cell::text(&a.name),
+                Cell::text(task(a.crt)),
+                Cell::num(value(a.crt_rms)),
+                Cell::text(task(a.cpt)),
+                Cell::num(value(a.cpt_peak)),
+            ],
+            false,
+        );
+    }
+    t
+}
+
+/// Per-joint peak reactions of the unbalanced robot.
+pub fn unbalanced_joints(r: &RunResults) -> Table {
+    let mut t = Table::new(&["Joint", "F_j [N]", "task", "M_j [N·m]", "task"]);
+    let opt_task = |x: Option<[usize; 2]>| x.map(task).unwrap_or_default();
+    for j in &r.unbalanced.joints {
+        t.push(
+            vec![
+                Cell::text(&j.name),
+                Cell::num(value(j.force)),
+                Cell::text(opt_task(j.force_task)),
+                Cell::num(value(j.moment)),
+                Cell::text(opt_task(j.moment_task)),
+            ],
+            false,
+        );
+    }
+    t
+}
+
+/// Variants per status and class.
+pub fn counts(r: &RunResults) -> Table {
+    let mut t = Table::new(&[
+        "Status",
+        "Meaning",
+        "Counterweights",
+        "Springs",
+        "Hybrid",
+        "Total",
+    ]);
+    let mut sums = [0usize; 4];
+    for c in &r.counts {
+        let n = [c.counterweights, c.springs, c.hybrid, c.total];
+        for (s, x) in sums.iter_mut().zip(n) {
+            *s += x;
+        }
+        let mut row = vec![Cell::text(c.status.name()), Cell::text(c.status.meaning())];
+        row.extend(n.iter().map(|x| Cell::num(x.to_string())));
+        t.push(row, false);
+    }
+    let mut row = vec![Cell::text("all"), Cell::empty()];
+    row.extend(sums.iter().map(|x| Cell::num(x.to_string())));
+    t.push(row, true);
+    t
+}
+
+fn opt(x: Option<f64>, f: fn(f64) -> String) -> String {
+    x.map(f).unwrap_or_default()
+}
+
+/// The global ranking (Fig. 7's order) with indicators.
+pub fn ranking(r: &RunResults) -> Table {
+    let mut t = Table::new(&[
+        "Rank",
+        "Variant",
+        "Elements",
+        "Class",
+        "Class rank",
+        "QTR [N·m]",
+        "QIT [N·m]",
+        "ΔQTR [%]",
+        "ΔQIT [%]",
+        "ΔR [%]",
+        "Objective [N·m]",
+        "Gap",
+        "Note",
+    ]);
+    for v in r.ranked() {
+        let eval = v.evaluation.as_ref();
+        let optim = v.optimiser.as_ref();
+        t.push(
+            vec![
+                Cell::num(v.rank.map(|x| x.to_string()).unwrap_or_default()),
+                Cell::text(v.name.clone().unwrap_or_default()),
+                Cell::text(v.label()),
+                Cell::text(v.class.name()),
+                Cell::num(v.class_rank.map(|x| x.to_string()).unwrap_or_default()),
+                Cell::num(opt(eval.map(|e| e.qtr), value)),
+                Cell::num(opt(eval.map(|e| e.qit), value)),
+                Cell::num(opt(v.dqtr, percent)),
+                Cell::num(opt(v.dqit, percent)),
+                Cell::num(opt(v.dr, percent)),
+                Cell::num(opt(optim.and_then(|o| o.objective), value)),
+                Cell::num(opt(optim.and_then(|o| o.gap), |g| format!("{:.1e}", g))),
+                Cell::text(if v.tie_broken_by_label {
+                    "tie broken by labels"
+                } else {
+                    ""
+                }),
+            ],
+            false,
+        );
+    }
+    t
+}
+
+/// The paper's Table 1: optimised parameters of the feasible variants, one row per element,
+/// in the paper's units (N/mm, mm, rad, kg).
+pub fn parameters(r: &RunResults) -> Table {
+    let mut t = Table::new(&[
+        "Variant", "Element", "Bodies", "K [N/mm]", "a [mm]", "α [rad]", "b [mm]", "β [rad]",
+        "m [kg]", "r [mm]", "φ [rad]",
+    ]);
+    for v in r.ranked() {
+        let Some(p) = &v.parameters else { continue };
+        let mut first = true;
+        let name = v.name.clone().unwrap_or_default();
+        for s in &p.springs {
+            let (a, alpha) = vector_cells(s.anchor_a, s.plane);
+            let (b, beta) = vector_cells(s.anchor_b, s.plane);
+            t.push(
+                vec![
+                    Cell::text(if first { name.clone() } else { String::new() }),
+                    Cell::text(&s.label),
+                    Cell::text(format!("{}–{}", s.body, s.other)),
+                    Cell::num(value(s.stiffness / 1000.0)),
+                    Cell::num(a),
+                    Cell::num(alpha),
+                    Cell::num(b),
+                    Cell::num(beta),
+                    Cell::empty(),
+                    Cell::empty(),
+                    Cell::empty(),
+                ],
+                first,
+            );
+            first = false;
+        }
+        for c in &p.counterweights {
+            let (rr, phi) = vector_cells(c.offset, c.plane);
+            t.push(
+                vec![
+                    Cell::text(if first { name.clone() } else { String::new() }),
+                    Cell::text(&c.label),
+                    Cell::text(&c.body),
+                    Cell::empty(),
+                    Cell::empty(),
+                    Cell::empty(),
+                    Cell::empty(),
+                    Cell::empty(),
+                    Cell::num(value(c.mass)),
+                    Cell::num(rr),
+                    Cell::num(phi),
+                ],
+                first,
+            );
+            first = false;
+        }
+    }
+    t
+}
+
+/// (length, angle) of a body-frame vector: polar in its plane when known (Table 1 style),
+/// else the Cartesian components in mm and no angle.
+fn vector_cells(v: [f64; 3], plane: Option<crate::results::Plane>) -> (String, String) {
+    match plane {
+        Some(p) => {
+            let (r, phi) = polar(v, p.axes());
+            let (a0, a1) = p.axes();
+            let off = v[3 - a0 - a1];
+            let len = if off.abs() > 1e-9 {
+                format!(
+                    "{} (out of plane {})",
+                    fixed(r * 1000.0, 1),
+                    fixed(off * 1000.0, 1)
+                )
+            } else {
+                fixed(r * 1000.0, 1)
+            };
+            (len, if r > 1e-12 { angle(phi) } else { "–".into() })
+        }
+        None => (
+            format!(
+                "({}, {}, {})",
+                fixed(v[0] * 1000.0, 1),
+                fixed(v[1] * 1000.0, 1),
+                fixed(v[2] * 1000.0, 1)
+            ),
+            String::new(),
+        ),
+    }
+}
+
+/// Best variant of each class.
+pub fn best_per_class(r: &RunResults) -> Table {
+    let mut t = Table::new(&[
+        "Class",
+        "Best variant",
+        "Elements",
+        "Rank",
+        "ΔQTR [%]",
+        "ΔQIT [%]",
+        "ΔR [%]",
+    ]);
+    for v in r.best_per_class() {
+        t.push(
+            vec![
+                Cell::text(v.class.title()),
+                Cell::text(v.name.clone().unwrap_or_default()),
+                Cell::text(v.label()),
+                Cell::num(v.rank.map(|x| x.to_string()).unwrap_or_default()),
+                Cell::num(opt(v.dqtr, percent)),
+                Cell::num(opt(v.dqit, percent)),
+                Cell::num(opt(v.dr, percent)),
+            ],
+            false,
+        );
+    }
+    t
+}
+
+/// Per-joint reactions and ΔR terms of every ranked variant.
+pub fn joint_reactions(r: &RunResults) -> Table {
+    let mut t = Table::new(&[
+        "Variant",
+        "Joint",
+        "F_j [N]",
+        "ΔF_j [%]",
+        "γ_F",
+        "M_j [N·m]",
+        "ΔM_j [%]",
+        "γ_M",
+        "ΔR term [%]",
+    ]);
+    for v in r.ranked() {
+        let (Some(e), Some(d)) = (&v.evaluation, &v.dr_terms) else {
+            continue;
+        };
+        for (k, (j, jv)) in e.joints.iter().zip(&d.joints).enumerate() {
+            t.push(
+                vec![
+                    Cell::text(if k == 0 {
+                        v.name.clone().unwrap_or_default()
+                    } else {
+                        String::new()
+                    }),
+                    Cell::text(&j.name),
+                    Cell::num(value(j.force)),
+                    Cell::num(opt(jv.dforce, percent)),
+                    Cell::num(fixed(jv.gamma_force, 3)),
+                    Cell::num(value(j.moment)),
+                    Cell::num(opt(jv.dmoment, percent)),
+                    Cell::num(fixed(jv.gamma_moment, 3)),
+                    Cell::num(fixed(jv.term_force + jv.term_moment, 2)),
+                ],
+                k == 0,
+            );
+        }
+    }
+    t
+}
+
+/// Balanced variants that were not ranked, and why (infeasible ones are only counted).
+pub fn not_ranked(r: &RunResults) -> Table {
+    let mut t = Table::new(&["Id", "Elements", "Class", "Status", "Reason"]);
+    for v in r.variants.iter().filter(|v| {
+        !matches!(
+            v.status,
+            VariantStatus::Feasible | VariantStatus::Infeasible
+        )
+    }) {
+        t.push(
+            vec![
+                Cell::num(v.id.to_string()),
+                Cell::text(v.label()),
+                Cell::text(v.class.name()),
+                Cell::text(v.status.name()),
+                Cell::text(v.reason.clone().unwrap_or_default()),
+            ],
+            false,
+        );
+    }
+    t
+}
+
+/// The paper's Table 2: RMS and |peak| motor torque along the path, with variations vs UB.
+pub fn path_table(p: &PathSimulation) -> Table {
+    let mechanisms: Vec<&str> = {
+        let mut m: Vec<&str> = Vec::new();
+        for s in &p.table {
+            if !m.contains(&s.mechanism.as_str()) {
+                m.push(&s.mechanism);
+            }
+        }
+        m
+    };
+    let mut header = vec!["Motor".to_string(), "".to_string()];
+    for (k, m) in mechanisms.iter().enumerate() {
+        header.push(format!("{m} T [N·m]"));
+        if k > 0 {
+            header.push(format!("{m} [%]"));
+        }
+    }
+    let mut t = Table {
+        header,
+        rows: Vec::new(),
+        group_starts: Vec::new(),
+    };
+    for a in &p.actuators {
+        for (stat, first) in [("RMS", true), ("|peak|", false)] {
+            let mut row = vec![
+                Cell::text(if first { a.clone() } else { String::new() }),
+                Cell::text(stat),
+            ];
+            for (k, m) in mechanisms.iter().enumerate() {
+                let s = p
+                    .table
+                    .iter()
+                    .find(|s| &s.actuator == a && s.mechanism == *m);
+                let (v, var) = match s {
+                    Some(s) if first => (s.rms, s.rms_variation),
+                    Some(s) => (s.peak, s.peak_variation),
+                    None => (f64::NAN, None),
+                };
+                row.push(Cell::num(if v.is_finite() {
+                    fixed(v, 2)
+                } else {
+                    String::new()
+                }));
+                if k > 0 {
+                    row.push(Cell::num(
+                        var.map(|x| fixed_signed(x, 1)).unwrap_or_default(),
+                    ));
+                }
+            }
+            t.push(row, first);
+        }
+    }
+    t
+}
+
+fn fixed_signed(x: f64, d: usize) -> String {
+    let s = fixed(x, d);
+    if x > 0.0 && s.chars().any(|c| ('1'..='9').contains(&c)) {
+        format!("+{s}")
+    } else {
+        s
+    }
+}
+
+/// The balance relations and free directions of a variant, as lines of text.
+pub fn relations(v: &VariantRecord) -> Vec<String> {
+    let mut lines = v.relations.clone();
+    for (k, d) in v.free_directions.iter().enumerate() {
+        let comps: Vec<String> = d
+            .components
+            .iter()
+            .map(|(name, c)| format!("{} {}", fixed(*c, 4), name))
+            .collect();
+        let mut line = format!("free direction {}: ({})", k + 1, comps.join(", "));
+        if let Some((lo, hi)) = d.positive_interval {
+            let b = |x: Option<f64>, inf: &str| x.map(value).unwrap_or_else(|| inf.to_string());
+            line.push_str(&format!(
+                "; positive for t in [{}, {}]",
+                b(lo, "−∞"),
+                b(hi, "+∞")
+            ));
+        }
+        lines.push(line);
+    }
+    lines
+}

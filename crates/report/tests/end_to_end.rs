@@ -1,0 +1,544 @@
+//! End to end: a hand-built palletizer-like run → finalize → all outputs in a temp dir → parse
+//! them back and check their structure.
+
+use std::f64::consts::PI;
+
+use counterpoise_report::*;
+use quick_xml::events::Event;
+use serde_json::json;
+
+fn task(a: usize, b: usize) -> TaskRef {
+    [a, b]
+}
+
+fn joints(f: [f64; 4], m: [f64; 4]) -> Vec<JointPeak> {
+    (0..4)
+        .map(|j| JointPeak {
+            name: format!("J{}", j + 1),
+            force: f[j],
+            force_task: Some(task(0, j + 1)),
+            moment: m[j],
+            moment_task: None,
+        })
+        .collect()
+}
+
+fn evaluation(qtr: f64, qit: f64, f: [f64; 4], m: [f64; 4]) -> Evaluation {
+    Evaluation {
+        qtr,
+        qtr_task: task(3, 40),
+        qit,
+        qit_task: task(5, 12),
+        actuators: (1..=3)
+            .map(|n| ActuatorSummary {
+                name: format!("M{n}"),
+                crt: task(n, 30 + n),
+                crt_rms: qtr / 3.0,
+                cpt: task(n + 1, 20),
+                cpt_peak: qit / 2.5,
+            })
+            .collect(),
+        joints: joints(f, m),
+        tasks: 1176,
+        excluded_tasks: 2,
+        reactions_minimum_norm: false,
+    }
+}
+
+fn element(label: &str) -> ElementInfo {
+    let spring = label.starts_with('K');
+    ElementInfo {
+        label: label.into(),
+        kind: if spring {
+            ElementKind::Spring
+        } else {
+            ElementKind::Counterweight
+        },
+        bodies: if spring {
+            vec![
+                format!("body{}", &label[1..2]),
+                format!("body{}", &label[2..3]),
+            ]
+        } else {
+            vec![format!("body{}", &label[1..])]
+        },
+    }
+}
+
+fn params(labels: &[&str]) -> PhysicalParameters {
+    let mut p = PhysicalParameters::default();
+    for l in labels {
+        if l.starts_with('K') {
+            p.springs.push(SpringParams {
+                label: l.to_string(),
+                body: format!("body{}", &l[1..2]),
+                other: format!("body{}", &l[2..3]),
+                stiffness: 5669.0,
+                anchor_a: [0.9989, 0.0, 0.0],
+                anchor_b: [0.0, 0.4999, 0.0],
+                plane: Some(Plane::Xy),
+            });
+        } else {
+            p.counterweights.push(CounterweightParams {
+                label: l.to_string(),
+                body: format!("body{}", &l[1..]),
+                mass: 228.6,
+                offset: [-0.0813, 0.0, 0.0],
+                plane: Some(Plane::Xy),
+            });
+        }
+    }
+    p
+}
+
+fn feasible(id: usize, labels: &[&str], class: Class, e: Evaluation) -> VariantRecord {
+    let mut v = VariantRecord::new(
+        id,
+        labels.iter().map(|l| element(l)).collect(),
+        class,
+        VariantStatus::Feasible,
+    );
+    v.parameters = Some(params(labels));
+    v.evaluation = Some(e);
+    v.relations = vec![format!("m4·r4x = −18.59 kg·m <{id}>")];
+    v.free_directions = vec![FreeDirection {
+        components: vec![("K43".into(), 1.0), ("K53".into(), -0.5)],
+        positive_interval: Some((Some(-2.0), None)),
+    }];
+    v.verification_residual = Some(3.2e-13);
+    v.optimiser = Some(OptimiserInfo {
+        objective: Some(12.5),
+        lower_bound: Some(12.4),
+        gap: Some(0.008),
+        iterations: Some(2),
+        message: None,
+    });
+    v
+}
+
+/// A run with every status, all three classes, torque charts and a path simulation.
+fn sample() -> RunResults {
+    let ub_f = [9000.0, 4000.0, 2500.0, 1500.0];
+    let ub_m = [3000.0, 1200.0, 600.0, 200.0];
+    let meta = RunMetadata {
+        tool: "counterpoise".into(),
+        tool_version: "0.1.0".into(),
+        case_name: "palletizer <test> & \"quotes\"".into(),
+        case_path: "cases/palletizer.json".into(),
+        dmax: 2,
+        jobs: 2,
+        date: "2026-11-22T00:00:00Z".into(),
+        timings: vec![
+            PhaseTiming {
+                phase: "unbalanced".into(),
+                seconds: 0.41,
+            },
+            PhaseTiming {
+                phase: "balance search".into(),
+                seconds: 0.12,
+            },
+            PhaseTiming {
+                phase: "optimisation".into(),
+                seconds: 7.9,
+            },
+        ],
+        notes: vec!["Payload excluded from balancing.".into()],
+    };
+    let mut r = RunResults::new(
+        meta,
+        json!({"name": "palletizer", "bodies": [{"name": "column"}]}),
+        evaluation(40.0, 90.0, ub_f, ub_m),
+    );
+    // Springs: dynamically identical (same QTR/QIT), different reactions.
+    r.variants.push(feasible(
+        10,
+        &["K42", "K43"],
+        Class::Springs,
+        evaluation(14.0, 50.0, [9100.0, 4100.0, 2500.0, 1500.0], ub_m),
+    ));
+    r.variants.push(feasible(
+        11,
+        &["K43", "K53"],
+        Class::Springs,
+        evaluation(14.0 + 1e-12, 50.0, [9000.0, 4400.0, 2500.0, 1500.0], ub_m),
+    ));
+    r.variants.push(feasible(
+        3,
+        &["m4", "m5"],
+        Class::Counterweights,
+        evaluation(
+            22.0,
+            60.0,
+            [11000.0, 4000.0, 2500.0, 1500.0],
+            [3600.0, 1200.0, 600.0, 200.0],
+        ),
+    ));
+    r.variants.push(feasible(
+        4,
+        &["m4", "m6"],
+        Class::Counterweights,
+        evaluation(24.0, 62.0, ub_f, ub_m),
+    ));
+    r.variants.push(feasible(
+        20,
+        &["m6", "K43"],
+        Class::Hybrid,
+        evaluation(15.0, 51.0, [9500.0, 4000.0, 2500.0, 1500.0], ub_m),
+    ));
+    let mut d = VariantRecord::new(
+        21,
+        vec![element("m4"), element("K42")],
+        Class::Hybrid,
+        VariantStatus::Discarded,
+    );
+    d.reason = Some("mass 620 kg > bound 500 kg".into());
+    r.variants.push(d);
+    let mut u = VariantRecord::new(
+        22,
+        vec![element("K52")],
+        Class::Springs,
+        VariantStatus::Unrealizable,
+    );
+    u.reason = Some("K·W ≠ α·βᵀ <unrealizable>".into());
+    r.variants.push(u);
+    r.variants.push(VariantRecord::new(
+        0,
+        vec![element("m1")],
+        Class::Counterweights,
+        VariantStatus::Infeasible,
+    ));
+    r.variants.push(VariantRecord::new(
+        1,
+        vec![element("m2")],
+        Class::Counterweights,
+        VariantStatus::Infeasible,
+    ));
+    let mut g = VariantRecord::new(
+        2,
+        vec![element("m3"), element("m4")],
+        Class::Counterweights,
+        VariantStatus::Degenerate,
+    );
+    g.reason = Some("m3 = 0".into());
+    r.variants.push(g);
+    r.variants.push(VariantRecord::new(
+        30,
+        vec![element("K21")],
+        Class::Springs,
+        VariantStatus::Undecided,
+    ));
+    r
+}
+
+/// Adds torque curves for UB and the best of each class, and a path simulation.
+fn add_curves(r: &mut RunResults) {
+    let best: Vec<(usize, String)> = r
+        .best_per_class()
+        .iter()
+        .map(|v| (v.id, v.display_name()))
+        .collect();
+    let t: Vec<f64> = (0..51).map(|k| k as f64 * 0.05).collect();
+    for (a, actuator) in ["M1", "M2", "M3"].iter().enumerate() {
+        let mut curves = vec![Curve {
+            label: "UB".into(),
+            variant: None,
+            values: t
+                .iter()
+                .map(|t| 20.0 + 10.0 * (2.0 * PI * t / 2.5).sin() * (a + 1) as f64)
+                .collect(),
+        }];
+        for (k, (id, name)) in best.iter().enumerate() {
+            curves.push(Curve {
+                label: name.clone(),
+                variant: Some(*id),
+                values: t
+                    .iter()
+                    .map(|t| (8.0 - k as f64) * (2.0 * PI * t / 2.5).sin())
+                    .collect(),
+            });
+        }
+        r.torque_charts.push(TorqueChart {
+            actuator: actuator.to_string(),
+            task: [a, 40],
+            critical_for: vec!["CRT of UB".into(), "CPT of UB".into()],
+            t: t.clone(),
+            curves,
+        });
+    }
+    let x: Vec<f64> = (0..200).map(|k| k as f64 * 0.025).collect();
+    let mech = |label: &str, variant: Option<usize>, scale: f64| PathMechanism {
+        label: label.into(),
+        variant,
+        torques: (0..3)
+            .map(|a| {
+                x.iter()
+                    .map(|x| scale * (10.0 + 5.0 * a as f64) * (x + a as f64).sin())
+                    .collect()
+            })
+            .collect(),
+    };
+    let mut mechanisms = vec![mech("UB", None, 1.0)];
+    for (k, (id, name)) in best.iter().enumerate() {
+        mechanisms.push(mech(name, Some(*id), 0.4 + 0.1 * k as f64));
+    }
+    let run = PathRun {
+        x_label: "time".into(),
+        x_unit: "s".into(),
+        x: x.clone(),
+        mechanisms: mechanisms.clone(),
+    };
+    let mut static_run = run.clone();
+    static_run.x_label = "path point".into();
+    static_run.x_unit = String::new();
+    r.path = Some(PathSimulation {
+        name: "Λ (A-C-B-E-F-D-A)".into(),
+        description: Some("5 s cycle, 150 kg payload picked at C, dropped at F".into()),
+        actuators: vec!["M1".into(), "M2".into(), "M3".into()],
+        static_run: Some(static_run),
+        dynamic_run: Some(run),
+        table: Vec::new(),
+    });
+}
+
+fn full() -> RunResults {
+    let mut r = sample();
+    r.finalize(&RankingOptions::default()).unwrap();
+    add_curves(&mut r);
+    r.finalize(&RankingOptions::default()).unwrap();
+    r
+}
+
+#[test]
+fn finalize_computes_indicators_and_ranks() {
+    let r = full();
+    let by_id = |id| r.variant(id).unwrap();
+    // Springs tie on ΔQTR/ΔQIT (−65 %, −44.44 %) and are separated by ΔR.
+    let (a, b) = (by_id(10), by_id(11));
+    assert!((a.dqtr.unwrap() + 65.0).abs() < 1e-9);
+    assert!((a.dqit.unwrap() - (50.0 - 90.0) / 90.0 * 100.0).abs() < 1e-9);
+    // ΔR by hand: ΣF = 17000; K42+K43 raises J1 by 100 N and J2 by 100 N → 200/17000·100.
+    assert!((a.dr.unwrap() - 200.0 / 17000.0 * 100.0).abs() < 1e-9);
+    // K43+K53 raises J2 by 400 N → 400/17000·100 (worse).
+    assert!((b.dr.unwrap() - 400.0 / 17000.0 * 100.0).abs() < 1e-9);
+    assert_eq!((a.rank, b.rank), (Some(1), Some(2)));
+    assert_eq!((a.class_rank, b.class_rank), (Some(1), Some(2)));
+    assert_eq!(by_id(20).rank, Some(3));
+    assert_eq!(by_id(20).class_rank, Some(1));
+    assert_eq!(by_id(3).rank, Some(4));
+    assert_eq!(by_id(4).class_rank, Some(2));
+    assert_eq!(a.name.as_deref(), Some("SB1"));
+    // Counter-weight variant m4+m5: ΔR = 2000/17000·100 + 600/5000·100.
+    let dr = 2000.0 / 17000.0 * 100.0 + 600.0 / 5000.0 * 100.0;
+    assert!((by_id(3).dr.unwrap() - dr).abs() < 1e-9);
+    // Non-feasible variants carry no Phase 3 fields.
+    assert!(by_id(21).rank.is_none() && by_id(21).dqtr.is_none());
+    // Counts.
+    let count = |s| r.counts.iter().find(|c| c.status == s).unwrap().total;
+    assert_eq!(count(VariantStatus::Feasible), 5);
+    assert_eq!(count(VariantStatus::Infeasible), 2);
+    assert_eq!(count(VariantStatus::Discarded), 1);
+    assert_eq!(
+        r.counts.iter().map(|c| c.total).sum::<usize>(),
+        r.variants.len()
+    );
+    // Path table: UB row has no variation, the others do.
+    let p = r.path.as_ref().unwrap();
+    assert_eq!(p.table.len(), 3 * 4);
+    assert!(p.table[0].rms_variation.is_none());
+    assert!((p.table[1].rms_variation.unwrap() + 60.0).abs() < 1e-9);
+    assert_eq!(r.best_per_class().len(), 3);
+}
+
+#[test]
+fn results_round_trip_through_json() {
+    let r = full();
+    let text = serde_json::to_string_pretty(&r).unwrap();
+    let back: RunResults = serde_json::from_str(&text).unwrap();
+    assert_eq!(back, r);
+    // The required per-variant fields are at the top level of a feasible record.
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let rec = v["variants"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|x| x["status"] == "feasible")
+        .unwrap();
+    for key in ["dqtr", "dqit", "dr", "rank", "class_rank"] {
+        assert!(rec.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(v["schema_version"], SCHEMA_VERSION);
+}
+
+#[test]
+fn feasible_without_evaluation_is_an_error() {
+    let mut r = sample();
+    r.variants[0].evaluation = None;
+    assert!(matches!(
+        r.finalize(&RankingOptions::default()),
+        Err(ResultsError::MissingEvaluation { id: 10, .. })
+    ));
+}
+
+/// Parses the HTML as XML (fails on any unbalanced tag) and returns the number of `<svg>`
+/// elements and of `<table>` elements.
+fn check_xhtml(html: &str) -> (usize, usize) {
+    let mut reader = quick_xml::Reader::from_str(html);
+    let mut stack: Vec<String> = Vec::new();
+    let (mut svgs, mut tables) = (0, 0);
+    loop {
+        match reader.read_event() {
+            Ok(Event::Start(e)) => {
+                let name = e.name().into_inner().to_string();
+                match name.as_str() {
+                    "svg" => svgs += 1,
+                    "table" => tables += 1,
+                    "script" | "link" | "img" | "iframe" => {
+                        panic!("external/active element <{name}>")
+                    }
+                    _ => {}
+                }
+                stack.push(name);
+            }
+            Ok(Event::End(e)) => {
+                let name = e.name().into_inner().to_string();
+                assert_eq!(stack.pop().as_deref(), Some(name.as_str()));
+            }
+            Ok(Event::Empty(e)) => {
+                let name = e.name().into_inner().to_string();
+                assert!(!["script", "link", "img"].contains(&name.as_str()));
+            }
+            Ok(Event::Eof) => break,
+            Ok(_) => {}
+            Err(e) => panic!(
+                "report.html is not well-formed at {}: {e}",
+                reader.buffer_position()
+            ),
+        }
+    }
+    assert!(stack.is_empty(), "unclosed: {stack:?}");
+    (svgs, tables)
+}
+
+#[test]
+fn writes_all_outputs_and_regenerates() {
+    let r = full();
+    // Set COUNTERPOISE_REPORT_SAMPLE=DIR to keep a copy of the sample report for viewing.
+    if let Some(keep) = std::env::var_os("COUNTERPOISE_REPORT_SAMPLE") {
+        write_outputs(std::path::Path::new(&keep), &r).unwrap();
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let written = write_outputs(&out, &r).unwrap();
+    assert_eq!(written.len(), 4);
+    for name in ["results.json", "report.html", "report.md", "ranking.csv"] {
+        assert!(out.join(name).is_file(), "{name}");
+    }
+    // No temporary files left behind.
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 4);
+
+    let back = read_results(&out).unwrap();
+    assert_eq!(back, r);
+
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let (svgs, tables) = check_xhtml(&html);
+    // 3 classes of bars + 3 torque charts + 3 static + 3 dynamic path charts.
+    let charts = counterpoise_report::charts::all(&r);
+    assert_eq!(charts.len(), 12);
+    assert_eq!(svgs, charts.len());
+    assert!(tables >= 8);
+    assert!(!html.contains("http://") || !html.contains("href="));
+    assert!(!html.contains("src="));
+    // Case-provided strings are escaped.
+    assert!(html.contains("palletizer &lt;test&gt; &amp; &quot;quotes&quot;"));
+    assert!(!html.contains("<test>"));
+    assert!(html.contains("&lt;unrealizable&gt;"));
+
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let ranking_rows: Vec<&str> = md
+        .lines()
+        .skip_while(|l| *l != "## Ranking")
+        .skip(4)
+        .take_while(|l| l.starts_with('|'))
+        .collect();
+    assert_eq!(ranking_rows.len(), 5, "{md}");
+    assert!(ranking_rows[0].starts_with("| 1 | SB1 | K42 + K43 |"));
+    assert!(md.contains("## Optimised parameters (Table 1)"));
+    assert!(
+        md.contains("| 998.9 | 0 |"),
+        "Table 1 anchor in mm and angle"
+    );
+
+    let csv = std::fs::read_to_string(out.join("ranking.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 6);
+    assert_eq!(lines[0], counterpoise_report::csv::HEADER.join(","));
+    assert!(lines[1].starts_with("1,1,SB1,10,K42 + K43,springs,"));
+    assert!(lines[3].starts_with("3,1,SB3,20,m6 + K43,hybrid,"));
+
+    // regenerate rewrites the reports from results.json alone.
+    std::fs::remove_file(out.join("report.html")).unwrap();
+    std::fs::write(out.join("report.md"), "stale").unwrap();
+    let rewritten = regenerate(&out).unwrap();
+    assert_eq!(rewritten.len(), 3);
+    assert_eq!(
+        std::fs::read_to_string(out.join("report.html")).unwrap(),
+        html
+    );
+    assert_eq!(std::fs::read_to_string(out.join("report.md")).unwrap(), md);
+}
+
+#[test]
+fn regenerate_rejects_other_schema_versions() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut v = serde_json::to_value(full()).unwrap();
+    v["schema_version"] = json!(99);
+    std::fs::write(dir.path().join("results.json"), v.to_string()).unwrap();
+    let err = regenerate(dir.path()).unwrap_err();
+    assert!(
+        matches!(err, OutputError::Schema { found: 99, .. }),
+        "{err}"
+    );
+    assert!(matches!(
+        regenerate(&dir.path().join("missing")),
+        Err(OutputError::Io { .. })
+    ));
+}
+
+#[test]
+fn empty_run_renders() {
+    // No feasible variant, no joints, no curves: still a valid report.
+    let mut r = sample();
+    r.variants.retain(|v| v.status != VariantStatus::Feasible);
+    r.unbalanced.joints.clear();
+    r.finalize(&RankingOptions::default()).unwrap();
+    let html = counterpoise_report::html::render(&r);
+    let (svgs, _) = check_xhtml(&html);
+    assert_eq!(svgs, 0);
+    assert!(html.contains("No feasible balanced variant"));
+    let csv = counterpoise_report::csv::render(&r);
+    assert_eq!(csv.lines().count(), 1);
+}
+
+#[test]
+fn output_is_deterministic() {
+    let a = full();
+    let mut shuffled = sample();
+    shuffled.variants.reverse();
+    shuffled.finalize(&RankingOptions::default()).unwrap();
+    add_curves(&mut shuffled);
+    shuffled.finalize(&RankingOptions::default()).unwrap();
+    let ranks = |r: &RunResults| {
+        let mut v: Vec<(usize, Option<usize>, Option<usize>)> = r
+            .variants
+            .iter()
+            .map(|v| (v.id, v.rank, v.class_rank))
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(ranks(&a), ranks(&shuffled));
+    assert_eq!(
+        counterpoise_report::csv::render(&a),
+        counterpoise_report::csv::render(&shuffled)
+    );
+}
