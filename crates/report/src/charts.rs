@@ -143,7 +143,7 @@ fn torque(r: &RunResults) -> Vec<Chart> {
                     })
                     .collect(),
                 include_zero: true,
-                width: 580.0,
+                width: 560.0,
                 height: 330.0,
             };
             Chart {
@@ -191,7 +191,7 @@ fn path_charts(
                     })
                     .collect(),
                 include_zero: true,
-                width: 580.0,
+                width: 560.0,
                 height: 330.0,
             };
             Chart {

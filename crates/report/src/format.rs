@@ -85,6 +85,16 @@ pub fn value(x: f64) -> String {
     }
 }
 
+/// [`value`] without trailing zeros (`1.00` → `1`), for coefficients in formulas.
+pub fn compact(x: f64) -> String {
+    let s = value(x);
+    if s.contains('.') && !s.contains('e') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 /// A percentage variation with an explicit sign, two decimals (resolution of the ranking).
 pub fn percent(x: f64) -> String {
     let s = fixed(x, 2);
@@ -159,6 +169,8 @@ mod tests {
         assert_eq!(value(17.482), "17.48");
         assert_eq!(value(0.5), "0.5000");
         assert_eq!(value(1.5e-6), "1.50e-6");
+        assert_eq!(compact(1.0), "1");
+        assert_eq!(compact(-0.5), "-0.5");
         assert_eq!(percent(-58.83), "-58.83");
         assert_eq!(percent(0.6), "+0.60");
         assert_eq!(percent(0.0), "0.00");

@@ -23,7 +23,8 @@ p.sub, p.note, .muted { color: var(--muted); }
 p.note { font-size: 13px; max-width: 900px; }
 table { border-collapse: collapse; margin: 6px 0 14px; font-variant-numeric: tabular-nums; }
 th, td { padding: 4px 10px; border-bottom: 1px solid var(--line); text-align: left; vertical-align: top; }
-th { background: var(--band); font-weight: 600; white-space: nowrap; }
+th { background: var(--band); font-weight: 600; vertical-align: bottom; }
+.scroll { overflow-x: auto; max-width: 100%; }
 td.n { text-align: right; white-space: nowrap; }
 tr.g td { border-top: 2px solid #b9c2c9; }
 table.kv th { display: none; }
@@ -254,7 +255,7 @@ fn push_charts(h: &mut String, charts: &[Chart], section: Section) {
 
 /// A table as HTML; `class` is an optional CSS class.
 fn table(t: &Table, class: &str) -> String {
-    let mut s = String::new();
+    let mut s = String::from("<div class=\"scroll\">");
     if class.is_empty() {
         s.push_str("<table>");
     } else {
@@ -276,6 +277,6 @@ fn table(t: &Table, class: &str) -> String {
         }
         s.push_str("</tr>");
     }
-    s.push_str("</tbody></table>");
+    s.push_str("</tbody></table></div>");
     s
 }

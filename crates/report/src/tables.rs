@@ -1,7 +1,7 @@
 //! The report's tables as plain data, built once and rendered by both the HTML and the Markdown
 //! writers, so the two reports can never disagree on a number.
 
-use crate::format::{angle, fixed, percent, polar, seconds, task, value};
+use crate::format::{angle, compact, fixed, percent, polar, seconds, task, value};
 use crate::results::{PathSimulation, RunResults, VariantRecord, VariantStatus};
 
 /// One cell: text, and whether it is a number (right-aligned).
@@ -430,9 +430,9 @@ pub fn path_table(p: &PathSimulation) -> Table {
     };
     let mut header = vec!["Motor".to_string(), "".to_string()];
     for (k, m) in mechanisms.iter().enumerate() {
-        header.push(format!("{m} T [N·m]"));
+        header.push(format!("{m}: T [N·m]"));
         if k > 0 {
-            header.push(format!("{m} [%]"));
+            header.push("Δ [%]".to_string());
         }
     }
     let mut t = Table {
@@ -486,18 +486,22 @@ fn fixed_signed(x: f64, d: usize) -> String {
 pub fn relations(v: &VariantRecord) -> Vec<String> {
     let mut lines = v.relations.clone();
     for (k, d) in v.free_directions.iter().enumerate() {
-        let comps: Vec<String> = d
-            .components
-            .iter()
-            .map(|(name, c)| format!("{} {}", fixed(*c, 4), name))
-            .collect();
-        let mut line = format!("free direction {}: ({})", k + 1, comps.join(", "));
+        let mut comps = String::new();
+        for (i, (name, c)) in d.components.iter().enumerate() {
+            let mag = compact(c.abs());
+            match (i, *c < 0.0) {
+                (0, false) => comps.push_str(&format!("{mag}·{name}")),
+                (0, true) => comps.push_str(&format!("−{mag}·{name}")),
+                (_, false) => comps.push_str(&format!(" + {mag}·{name}")),
+                (_, true) => comps.push_str(&format!(" − {mag}·{name}")),
+            }
+        }
+        let mut line = format!("free direction {}: {comps}", k + 1);
         if let Some((lo, hi)) = d.positive_interval {
-            let b = |x: Option<f64>, inf: &str| x.map(value).unwrap_or_else(|| inf.to_string());
+            let lo = lo.map(compact).unwrap_or_else(|| "−∞".into());
+            let hi = hi.map(compact).unwrap_or_else(|| "+∞".into());
             line.push_str(&format!(
-                "; positive for t in [{}, {}]",
-                b(lo, "−∞"),
-                b(hi, "+∞")
+                " (all masses and stiffnesses positive for step t in [{lo}, {hi}])"
             ));
         }
         lines.push(line);
