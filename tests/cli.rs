@@ -30,7 +30,10 @@ fn check_summarises_the_palletizer() {
     let text = stdout(&out);
     // palletizer.md: total ≈ 1990 kg with the 800 kg base, which does not move: 1188.625 kg moves
     assert!(text.contains("total mass 1188.625 kg"), "{text}");
-    assert!(text.contains("V = const − 672.84·sin(th2) + 2830.49·sin(th3) J"), "{text}");
+    assert!(
+        text.contains("V = const − 672.84·sin(th2) + 2830.49·sin(th3) J"),
+        "{text}"
+    );
     assert!(text.contains("343 points, 343 reachable"), "{text}");
     assert!(text.contains("Dmax 2 → 406 variants"), "{text}");
 }
@@ -76,7 +79,12 @@ fn variants_json_lists_every_variant_with_elements_and_status() {
     assert_eq!(m4["elements"][0]["type"], "counterweight");
     assert_eq!(m4["elements"][0]["bodies"][0], "upper_arm");
     assert!(m4["verification"]["residual"].as_f64().unwrap() < 1e-9);
-    let total: u64 = doc["counts"].as_object().unwrap().values().map(|v| v.as_u64().unwrap()).sum();
+    let total: u64 = doc["counts"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
     assert_eq!(total, 28);
 }
 
