@@ -37,7 +37,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{DynamicsError, TaskFailure};
-use crate::indicators::{Indicators, TaskStats, reduce};
+use crate::indicators::{Indicators, StatsTable, TaskStats, reduce};
 use crate::params::ParameterSet;
 use crate::runner::{Evaluator, Workspace};
 use crate::tasks::TaskSet;
@@ -49,6 +49,9 @@ pub struct EvaluateOptions {
     pub samples: Option<usize>,
     /// Compute joint reactions (`F_j`, `M_j`).
     pub reactions: bool,
+    /// Use the cyclic-coordinate decomposition ([`crate::symmetry`], `fast` module) when the
+    /// model has a cyclic coordinate; `false` runs every task directly (the reference path).
+    pub shortcut: bool,
 }
 
 impl Default for EvaluateOptions {
@@ -56,6 +59,7 @@ impl Default for EvaluateOptions {
         EvaluateOptions {
             samples: None,
             reactions: true,
+            shortcut: true,
         }
     }
 }
@@ -84,6 +88,8 @@ pub struct EvaluationReport {
     pub evaluated: usize,
     pub excluded: Excluded,
     pub reactions_minimum_norm: bool,
+    /// Chart coordinate found cyclic and factored out of the task loop (`null` if none).
+    pub cyclic_coordinate: Option<String>,
     #[serde(flatten)]
     pub indicators: Indicators,
 }
@@ -94,10 +100,19 @@ pub struct GridEvaluation {
     pub tasks: TaskSet,
     /// One per column.
     pub indicators: Vec<Indicators>,
-    /// Per task and column statistics (`None` for an excluded task), task-major.
-    pub stats: Vec<Option<Vec<TaskStats>>>,
+    /// Per task and column statistics (see [`GridEvaluation::stats`]).
+    pub table: StatsTable,
     pub excluded: Excluded,
     pub reactions_minimum_norm: bool,
+    /// The cyclic coordinate whose value was factored out, if the shortcut was used.
+    pub cyclic_coordinate: Option<String>,
+}
+
+impl GridEvaluation {
+    /// Statistics of task `w` for column `c` (`None` when the task was excluded).
+    pub fn stats(&self, w: usize, c: usize) -> Option<TaskStats> {
+        self.table.get(w, c)
+    }
 }
 
 fn excluded_from(failures: &[TaskFailure]) -> Excluded {
@@ -128,8 +143,59 @@ pub fn evaluate_grid(
         options.samples,
     )?;
     let ev = Evaluator::new(model)?;
+    let cyclic = if options.shortcut && params.springs.iter().all(|s| s.other.is_some()) {
+        crate::symmetry::detect_cyclic(model, &ev.mech)
+    } else {
+        None
+    };
+    let joints = if options.reactions {
+        ev.reactions.joint_count()
+    } else {
+        0
+    };
+    let mut table = StatsTable::new(tasks.len(), params.len(), ev.mech.n, joints);
+    let failures = match cyclic {
+        Some(cyc) => {
+            crate::fast::evaluate_cyclic(&ev, cyc, &tasks, params, options.reactions, &mut table)
+        }
+        None => {
+            let mut failures = Vec::new();
+            for (w, r) in direct_tasks(&ev, &tasks, params, options.reactions)
+                .into_iter()
+                .enumerate()
+            {
+                match r {
+                    Ok(s) => table.set(w, &s),
+                    Err(f) => failures.push(f),
+                }
+            }
+            failures
+        }
+    };
+    let names = ev.actuator_names();
+    let joint_names = ev.joint_names();
+    let indicators = (0..params.len())
+        .map(|c| reduce(&table, c, &names, &joint_names, |w| tasks.pair(w)))
+        .collect();
+    Ok(GridEvaluation {
+        indicators,
+        table,
+        excluded: excluded_from(&failures),
+        reactions_minimum_norm: options.reactions && ev.reactions.minimum_norm,
+        cyclic_coordinate: cyclic.map(|c| model.coordinates[c.coordinate].name.clone()),
+        tasks,
+    })
+}
+
+/// Every task run directly: Newton along the move, dynamics at every sample.
+fn direct_tasks(
+    ev: &Evaluator,
+    tasks: &TaskSet,
+    params: &ParameterSet,
+    with_reactions: bool,
+) -> Vec<Result<Vec<TaskStats>, TaskFailure>> {
     let grid_q: Vec<_> = tasks.points.par_iter().map(|u| ev.solve_point(u)).collect();
-    let results: Vec<Result<Vec<TaskStats>, TaskFailure>> = (0..tasks.len())
+    (0..tasks.len())
         .into_par_iter()
         .map_init(Workspace::default, |ws, w| {
             let (i, j) = tasks.pair(w);
@@ -150,7 +216,7 @@ pub fn evaluate_grid(
                 tasks.samples,
                 &mut q,
                 params,
-                options.reactions,
+                with_reactions,
                 ws,
             )
             .map_err(|(sample, reason)| TaskFailure {
@@ -159,34 +225,7 @@ pub fn evaluate_grid(
                 reason,
             })
         })
-        .collect();
-    let mut failures = Vec::new();
-    let mut stats = Vec::with_capacity(results.len());
-    for r in results {
-        match r {
-            Ok(s) => stats.push(Some(s)),
-            Err(f) => {
-                failures.push(f);
-                stats.push(None);
-            }
-        }
-    }
-    let names = ev.actuator_names();
-    let joints = ev.joint_names();
-    let indicators = (0..params.len())
-        .map(|c| {
-            let per_task: Vec<Option<&TaskStats>> =
-                stats.iter().map(|s| s.as_ref().map(|v| &v[c])).collect();
-            reduce(&per_task, &names, &joints, |w| tasks.pair(w))
-        })
-        .collect();
-    Ok(GridEvaluation {
-        indicators,
-        stats,
-        excluded: excluded_from(&failures),
-        reactions_minimum_norm: options.reactions && ev.reactions.minimum_norm,
-        tasks,
-    })
+        .collect()
 }
 
 /// The unbalanced indicators of a model over its task grid.
@@ -211,6 +250,7 @@ pub fn evaluate(
         evaluated: tasks.len() - grid.excluded.count,
         excluded: grid.excluded.clone(),
         reactions_minimum_norm: grid.reactions_minimum_norm,
+        cyclic_coordinate: grid.cyclic_coordinate.clone(),
         indicators: grid.indicators.swap_remove(0),
     })
 }

@@ -132,51 +132,127 @@ pub struct Indicators {
     pub joints: Vec<JointIndicators>,
 }
 
-/// Reduces per-task statistics (in task order; `None` = excluded) to indicators.
-/// `pair(w)` gives the grid indices of task `w`.
+/// Per-task statistics of many columns in one flat table: for task `w` and column `c`,
+/// `[rms (na), peak (na), total_peak, force_peak (nj), moment_peak (nj)]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StatsTable {
+    pub tasks: usize,
+    pub columns: usize,
+    pub actuators: usize,
+    /// Joints with reaction statistics (0 without reactions).
+    pub joints: usize,
+    /// Whether each task ran (false: excluded).
+    pub ok: Vec<bool>,
+    data: Vec<f64>,
+}
+
+impl StatsTable {
+    pub fn new(tasks: usize, columns: usize, actuators: usize, joints: usize) -> StatsTable {
+        let width = 2 * actuators + 1 + 2 * joints;
+        StatsTable {
+            tasks,
+            columns,
+            actuators,
+            joints,
+            ok: vec![false; tasks],
+            data: vec![0.0; tasks * columns * width],
+        }
+    }
+
+    /// Values per task and column.
+    pub fn width(&self) -> usize {
+        2 * self.actuators + 1 + 2 * self.joints
+    }
+
+    /// The raw row of task `w`, column `c` (`None` for an excluded task).
+    pub fn row(&self, w: usize, c: usize) -> Option<&[f64]> {
+        let width = self.width();
+        let off = (w * self.columns + c) * width;
+        self.ok[w].then(|| &self.data[off..off + width])
+    }
+
+    /// Statistics of task `w`, column `c` (`None` for an excluded task).
+    pub fn get(&self, w: usize, c: usize) -> Option<TaskStats> {
+        let r = self.row(w, c)?;
+        let (na, nj) = (self.actuators, self.joints);
+        Some(TaskStats {
+            rms: r[..na].to_vec(),
+            peak: r[na..2 * na].to_vec(),
+            total_peak: r[2 * na],
+            force_peak: r[2 * na + 1..2 * na + 1 + nj].to_vec(),
+            moment_peak: r[2 * na + 1 + nj..].to_vec(),
+        })
+    }
+
+    /// Stores the statistics of task `w` (one per column) and marks it as run.
+    pub fn set(&mut self, w: usize, stats: &[TaskStats]) {
+        let width = self.width();
+        let (na, nj) = (self.actuators, self.joints);
+        for (c, s) in stats.iter().enumerate() {
+            let off = (w * self.columns + c) * width;
+            let r = &mut self.data[off..off + width];
+            r[..na].copy_from_slice(&s.rms[..na]);
+            r[na..2 * na].copy_from_slice(&s.peak[..na]);
+            r[2 * na] = s.total_peak;
+            if nj > 0 {
+                r[2 * na + 1..2 * na + 1 + nj].copy_from_slice(&s.force_peak[..nj]);
+                r[2 * na + 1 + nj..].copy_from_slice(&s.moment_peak[..nj]);
+            }
+        }
+        self.ok[w] = true;
+    }
+
+    /// Copies task `from`'s rows to task `to`.
+    pub fn copy_task(&mut self, from: usize, to: usize) {
+        let n = self.columns * self.width();
+        self.data.copy_within(from * n..(from + 1) * n, to * n);
+        self.ok[to] = self.ok[from];
+    }
+}
+
+/// Reduces column `c` of the table (tasks in index order, excluded ones skipped) to
+/// indicators. `pair(w)` gives the grid indices of task `w`.
 pub fn reduce(
-    stats: &[Option<&TaskStats>],
+    table: &StatsTable,
+    c: usize,
     actuator_names: &[String],
     joint_names: &[String],
     pair: impl Fn(usize) -> (usize, usize),
 ) -> Indicators {
-    let na = actuator_names.len();
-    let nj = joint_names.len();
+    let na = table.actuators;
+    let nj = table.joints;
     let mut qtr = (0.0, 0usize);
     let mut qit = (0.0, 0usize);
     let mut crt = vec![(0.0, 0usize); na];
     let mut cpt = vec![(0.0, 0usize); na];
     let mut fj = vec![(0.0, 0usize); nj];
     let mut mj = vec![(0.0, 0usize); nj];
-    let mut any_reactions = false;
     let mut first = true;
-    for (w, s) in stats.iter().enumerate() {
-        let Some(s) = s else { continue };
+    for w in 0..table.tasks {
+        let Some(r) = table.row(w, c) else { continue };
         let better = |cur: &(f64, usize), v: f64| first || v > cur.0;
-        let total: f64 = s.rms.iter().sum();
+        let total: f64 = r[..na].iter().sum();
         if better(&qtr, total) {
             qtr = (total, w);
         }
-        if better(&qit, s.total_peak) {
-            qit = (s.total_peak, w);
+        if better(&qit, r[2 * na]) {
+            qit = (r[2 * na], w);
         }
         for a in 0..na {
-            if better(&crt[a], s.rms[a]) {
-                crt[a] = (s.rms[a], w);
+            if better(&crt[a], r[a]) {
+                crt[a] = (r[a], w);
             }
-            if better(&cpt[a], s.peak[a]) {
-                cpt[a] = (s.peak[a], w);
+            if better(&cpt[a], r[na + a]) {
+                cpt[a] = (r[na + a], w);
             }
         }
-        if !s.force_peak.is_empty() {
-            any_reactions = true;
-            for j in 0..nj {
-                if better(&fj[j], s.force_peak[j]) {
-                    fj[j] = (s.force_peak[j], w);
-                }
-                if better(&mj[j], s.moment_peak[j]) {
-                    mj[j] = (s.moment_peak[j], w);
-                }
+        for j in 0..nj {
+            let (f, m) = (r[2 * na + 1 + j], r[2 * na + 1 + nj + j]);
+            if better(&fj[j], f) {
+                fj[j] = (f, w);
+            }
+            if better(&mj[j], m) {
+                mj[j] = (m, w);
             }
         }
         first = false;
@@ -199,18 +275,14 @@ pub fn reduce(
                 cpt_peak: cpt[a].0,
             })
             .collect(),
-        joints: if any_reactions {
-            (0..nj)
-                .map(|j| JointIndicators {
-                    name: joint_names[j].clone(),
-                    force: fj[j].0,
-                    force_task: idx(fj[j].1),
-                    moment: mj[j].0,
-                    moment_task: idx(mj[j].1),
-                })
-                .collect()
-        } else {
-            Vec::new()
-        },
+        joints: (0..nj)
+            .map(|j| JointIndicators {
+                name: joint_names[j].clone(),
+                force: fj[j].0,
+                force_task: idx(fj[j].1),
+                moment: mj[j].0,
+                moment_task: idx(mj[j].1),
+            })
+            .collect(),
     }
 }

@@ -13,7 +13,9 @@
 pub mod compiled;
 pub mod error;
 pub mod evaluate;
+pub mod fast;
 pub mod indicators;
+pub mod kernel;
 pub mod law;
 pub mod lu;
 pub mod mechanism;
@@ -21,6 +23,8 @@ pub mod params;
 pub mod reactions;
 pub mod regressor;
 pub mod runner;
+mod simd;
+pub mod symmetry;
 pub mod tasks;
 
 pub use error::{DynamicsError, FailureReason, TaskFailure};

@@ -264,46 +264,63 @@ impl Mechanism {
 
     /// Pose, Jacobians, velocity and acceleration of body `b` from evaluated poses.
     pub fn body_kin(&self, pose: &[f64], b: usize, qd: &[f64], qdd: &[f64]) -> BodyKin {
-        let n = self.n;
+        let mut out = self.body_frame(pose, b);
+        self.set_motion(pose, b, &mut out, qd, qdd);
+        out
+    }
+
+    /// Pose and Jacobians of body `b` (velocities and accelerations left zero).
+    pub fn body_frame(&self, pose: &[f64], b: usize) -> BodyKin {
         let s0 = self.slot(pose, b, 0);
         let r = Self::rot(s0);
-        let p = Vector3::new(s0[9], s0[10], s0[11]);
         let mut out = BodyKin {
             r,
-            p,
+            p: Vector3::new(s0[9], s0[10], s0[11]),
             ..BodyKin::default()
         };
+        let rt = r.transpose();
+        for k in 0..self.n {
+            let s = self.slot(pose, b, 1 + k);
+            out.jv[k] = Vector3::new(s[9], s[10], s[11]);
+            out.jw[k] = vee(&(Self::rot(s) * rt));
+        }
+        out
+    }
+
+    /// Fills the velocity and acceleration of a body whose frame came from
+    /// [`Mechanism::body_frame`].
+    pub fn set_motion(&self, pose: &[f64], b: usize, k: &mut BodyKin, qd: &[f64], qdd: &[f64]) {
+        let n = self.n;
         let mut rdd = Matrix3::zeros();
         let mut a = Vector3::zeros();
-        for k in 0..n {
-            let s = self.slot(pose, b, 1 + k);
-            let rk = Self::rot(s);
-            let pk = Vector3::new(s[9], s[10], s[11]);
-            out.jv[k] = pk;
-            out.jw[k] = vee(&(rk * r.transpose()));
-            out.v += pk * qd[k];
-            out.w += out.jw[k] * qd[k];
-            rdd += rk * qdd[k];
-            a += pk * qdd[k];
+        let mut v = Vector3::zeros();
+        let mut w = Vector3::zeros();
+        for j in 0..n {
+            let s = self.slot(pose, b, 1 + j);
+            v += k.jv[j] * qd[j];
+            w += k.jw[j] * qd[j];
+            rdd += Self::rot(s) * qdd[j];
+            a += k.jv[j] * qdd[j];
         }
         for l in 0..n {
-            for k in 0..=l {
-                let weight = if k == l {
-                    qd[k] * qd[k]
+            for j in 0..=l {
+                let weight = if j == l {
+                    qd[j] * qd[j]
                 } else {
-                    2.0 * qd[k] * qd[l]
+                    2.0 * qd[j] * qd[l]
                 };
                 if weight == 0.0 {
                     continue;
                 }
-                let s = self.slot(pose, b, 1 + n + packed(k, l));
+                let s = self.slot(pose, b, 1 + n + packed(j, l));
                 rdd += Self::rot(s) * weight;
                 a += Vector3::new(s[9], s[10], s[11]) * weight;
             }
         }
-        out.a = a;
-        out.alpha = vee(&(rdd * r.transpose()));
-        out
+        k.v = v;
+        k.w = w;
+        k.a = a;
+        k.alpha = vee(&(rdd * k.r.transpose()));
     }
 
     /// `f(q)` into `u`, and `G = ∂f/∂q` (row-major) into `g` when given.

@@ -288,33 +288,7 @@ impl ReactionSolver {
         let a = self.matrix(&frames, kin);
         let rows = 6 * self.bodies;
         let l = self.bodies;
-        // Joint displacement rate per unit actuated coordinate, per actuator.
-        let kappas: Vec<f64> = self
-            .actuated
-            .iter()
-            .map(|&(act, joint)| {
-                let j = &self.joints[joint];
-                let f = &frames[joint];
-                let mut row = [0.0; counterpoise_symbolic::MAX_VARS];
-                for (k, value) in row.iter_mut().enumerate().take(mech.n) {
-                    let rate = |side: usize| -> Vector3<f64> {
-                        match j.bodies[side] {
-                            BodyId::Base => Vector3::zeros(),
-                            BodyId::Body(b) => {
-                                if j.kind == JointKind::Prismatic {
-                                    kin[b].jv[k] + kin[b].jw[k].cross(&(f.point - kin[b].p))
-                                } else {
-                                    kin[b].jw[k]
-                                }
-                            }
-                        }
-                    };
-                    *value = f.axis.dot(&(rate(1) - rate(0)));
-                }
-                lu.solve_transpose(&mut row);
-                row[act]
-            })
-            .collect();
+        let kappas = self.kappas(&frames, kin, lu, mech.n);
         let mut b = DMatrix::zeros(rows, columns.len());
         for (c, &p) in columns.iter().enumerate() {
             let col = params.column(p);
@@ -381,6 +355,225 @@ impl ReactionSolver {
             .collect()
     }
 
+    /// Joint displacement per unit actuated coordinate, per actuator: `κ` with
+    /// `j_row = κ·G_a` (`j_row` the joint's relative rate along its axis as a row in `q̇`),
+    /// i.e. `κ = (G⁻ᵀ j_rowᵀ)_a`.
+    fn kappas(&self, frames: &[JointFrame], kin: &[BodyKin], lu: &SmallLu, n: usize) -> Vec<f64> {
+        self.actuated
+            .iter()
+            .map(|&(act, joint)| {
+                let j = &self.joints[joint];
+                let f = &frames[joint];
+                let mut row = [0.0; counterpoise_symbolic::MAX_VARS];
+                for (k, value) in row.iter_mut().enumerate().take(n) {
+                    let rate = |side: usize| -> Vector3<f64> {
+                        match j.bodies[side] {
+                            BodyId::Base => Vector3::zeros(),
+                            BodyId::Body(b) => {
+                                if j.kind == JointKind::Prismatic {
+                                    kin[b].jv[k] + kin[b].jw[k].cross(&(f.point - kin[b].p))
+                                } else {
+                                    kin[b].jw[k]
+                                }
+                            }
+                        }
+                    };
+                    *value = f.axis.dot(&(rate(1) - rate(0)));
+                }
+                lu.solve_transpose(&mut row);
+                row[act]
+            })
+            .collect()
+    }
+
+    /// Factors the reaction equations of one sample into `work` (geometry and `q` only: the
+    /// factorisation serves every velocity state and parameter column of the sample).
+    pub fn prepare(
+        &self,
+        mech: &Mechanism,
+        pose: &[f64],
+        kin: &[BodyKin],
+        lu: &SmallLu,
+        work: &mut ReactionWork,
+    ) {
+        let rows = 6 * self.bodies;
+        let k = self.unknowns;
+        work.rows = rows;
+        work.k = k;
+        work.frames = self.frames(mech, pose);
+        work.kappas = self.kappas(&work.frames, kin, lu, mech.n);
+        work.a.clear();
+        work.a.resize(rows * k, 0.0);
+        work.nz.resize(k, Vec::new());
+        for (j, f) in self.joints.iter().zip(&work.frames) {
+            let mut col = j.offset;
+            for e in &f.forces {
+                for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
+                    if let BodyId::Body(b) = j.bodies[side] {
+                        let m = (f.point - kin[b].p).cross(e);
+                        for r in 0..3 {
+                            work.a[col * rows + 6 * b + r] += sign * e[r];
+                            work.a[col * rows + 6 * b + 3 + r] += sign * m[r];
+                        }
+                    }
+                }
+                col += 1;
+            }
+            for e in &f.moments {
+                for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
+                    if let BodyId::Body(b) = j.bodies[side] {
+                        for r in 0..3 {
+                            work.a[col * rows + 6 * b + 3 + r] += sign * e[r];
+                        }
+                    }
+                }
+                col += 1;
+            }
+        }
+        for c in 0..k {
+            let nz = &mut work.nz[c];
+            nz.clear();
+            nz.extend((0..rows).filter(|&r| work.a[c * rows + r] != 0.0));
+        }
+        work.pinv = None;
+        if self.fast {
+            // S = A Aᵀ + U Uᵀ, lower Cholesky in place.
+            work.l.clear();
+            work.l.resize(rows * rows, 0.0);
+            for c in 0..k {
+                let col = &work.a[c * rows..(c + 1) * rows];
+                for &r1 in &work.nz[c] {
+                    for &r2 in &work.nz[c] {
+                        if r2 <= r1 {
+                            work.l[r1 * rows + r2] += col[r1] * col[r2];
+                        }
+                    }
+                }
+            }
+            let u = mobility_basis(kin, mech.n);
+            for c in 0..u.ncols() {
+                for r1 in 0..rows {
+                    let x = u[(r1, c)];
+                    if x == 0.0 {
+                        continue;
+                    }
+                    for r2 in 0..=r1 {
+                        work.l[r1 * rows + r2] += x * u[(r2, c)];
+                    }
+                }
+            }
+            if cholesky_in_place(&mut work.l, rows) {
+                work.lt.resize(rows * rows, 0.0);
+                for i in 0..rows {
+                    for j in 0..=i {
+                        work.lt[j * rows + i] = work.l[i * rows + j];
+                    }
+                }
+                return;
+            }
+            FALLBACKS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+        let a = DMatrix::from_column_slice(rows, k, &work.a);
+        let svd = a.svd(true, true);
+        let smax = svd.singular_values.max();
+        work.pinv = Some(
+            svd.pseudo_inverse(RANK_TOLERANCE * smax)
+                .unwrap_or_else(|_| DMatrix::zeros(k, rows)),
+        );
+    }
+
+    /// Subtracts the actuator wrenches of actuator forces `qu` from the right-hand side `b`
+    /// (one column, `6L`) of a prepared sample.
+    pub fn subtract_actuators(
+        &self,
+        work: &ReactionWork,
+        kin: &[BodyKin],
+        qu: &[f64],
+        b: &mut [f64],
+    ) {
+        for (&(act, joint), &kappa) in self.actuated.iter().zip(&work.kappas) {
+            let j = &self.joints[joint];
+            let f = &work.frames[joint];
+            let tau = qu[act] / kappa;
+            for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
+                if let BodyId::Body(bi) = j.bodies[side] {
+                    if j.kind == JointKind::Prismatic {
+                        let force = f.axis * (sign * tau);
+                        let moment = (f.point - kin[bi].p).cross(&force);
+                        for r in 0..3 {
+                            b[6 * bi + r] -= force[r];
+                            b[6 * bi + 3 + r] -= moment[r];
+                        }
+                    } else {
+                        for r in 0..3 {
+                            b[6 * bi + 3 + r] -= sign * tau * f.axis[r];
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Solves a prepared sample for `m` right-hand sides `b` (`6L × m`, row-major; destroyed)
+    /// and writes per joint the force and moment vectors into `out` (`6J × m`, row-major: row
+    /// `6j + r` holds component `r` of joint `j`'s force for `r < 3`, of its moment otherwise).
+    pub fn solve_prepared(
+        &self,
+        work: &mut ReactionWork,
+        b: &mut [f64],
+        m: usize,
+        out: &mut [f64],
+    ) {
+        let rows = work.rows;
+        let k = work.k;
+        work.y.clear();
+        work.y.resize(k * m, 0.0);
+        if let Some(pinv) = &work.pinv {
+            for c in 0..k {
+                for r in 0..rows {
+                    let x = pinv[(c, r)];
+                    if x != 0.0 {
+                        for p in 0..m {
+                            work.y[c * m + p] += x * b[r * m + p];
+                        }
+                    }
+                }
+            }
+        } else {
+            chunk_solve(
+                &work.l,
+                &work.lt,
+                rows,
+                &work.a,
+                &work.nz,
+                k,
+                b,
+                m,
+                &mut work.y,
+                &mut work.z,
+            );
+        }
+        out[..6 * self.joints.len() * m].fill(0.0);
+        for (jn, (j, f)) in self.joints.iter().zip(&work.frames).enumerate() {
+            let bases = f
+                .forces
+                .iter()
+                .map(|e| (e, 0))
+                .chain(f.moments.iter().map(|e| (e, 3)));
+            for (col, (e, base)) in (j.offset..).zip(bases) {
+                let lam = &work.y[col * m..(col + 1) * m];
+                for r in 0..3 {
+                    if e[r] != 0.0 {
+                        let o = &mut out[(6 * jn + base + r) * m..(6 * jn + base + r + 1) * m];
+                        for p in 0..m {
+                            o[p] += e[r] * lam[p];
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// `λ = A⁺ b` for every column of `b`.
     fn min_norm_solve(
         &self,
@@ -400,6 +593,186 @@ impl ReactionSolver {
         let smax = svd.singular_values.max();
         svd.solve(b, RANK_TOLERANCE * smax)
             .unwrap_or_else(|_| DMatrix::zeros(a.ncols(), b.ncols()))
+    }
+}
+
+/// Samples where the fast path's Cholesky failed and the SVD fallback ran (diagnostics).
+pub static FALLBACKS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// Per-sample reaction factorisation (see [`ReactionSolver::prepare`]).
+#[derive(Clone, Debug, Default)]
+pub struct ReactionWork {
+    rows: usize,
+    k: usize,
+    frames: Vec<JointFrame>,
+    kappas: Vec<f64>,
+    /// `A`, column-major.
+    a: Vec<f64>,
+    /// Non-zero rows of each column of `A`.
+    nz: Vec<Vec<usize>>,
+    /// Lower Cholesky factor of `AAᵀ + UUᵀ`, row-major.
+    l: Vec<f64>,
+    /// `Lᵀ`, row-major.
+    lt: Vec<f64>,
+    /// `A⁺` when the fast path is off or failed.
+    pinv: Option<DMatrix<f64>>,
+    y: Vec<f64>,
+    z: Vec<[f64; 8]>,
+}
+
+/// Dot product with eight independent accumulators (vectorises; fixed summation order).
+#[inline(always)]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 8];
+    let ca = a.chunks_exact(8);
+    let cb = b.chunks_exact(8);
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for p in 0..8 {
+            acc[p] += x[p] * y[p];
+        }
+    }
+    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
+}
+
+crate::simd::multiversion! {
+/// Lower Cholesky factorisation in place (row-major `n × n`, lower triangle used, upper
+/// triangle zero); false when the matrix is not numerically positive definite.
+fn cholesky_in_place(l: &mut [f64], n: usize) -> bool {
+    let max_diag = (0..n).fold(0.0f64, |m, i| m.max(l[i * n + i]));
+    for j in 0..n {
+        let (head, tail) = l.split_at_mut((j + 1) * n);
+        let row_j = &mut head[j * n..];
+        let d = row_j[j] - dot(&row_j[..j], &row_j[..j]);
+        if d.is_nan() || d <= 1e-13 * max_diag {
+            return false;
+        }
+        let d = d.sqrt();
+        row_j[j] = d;
+        let inv = 1.0 / d;
+        let row_j = &head[j * n..j * n + j];
+        for row_i in tail.chunks_exact_mut(n) {
+            let x = row_i[j] - dot(&row_i[..j], row_j);
+            row_i[j] = x * inv;
+        }
+    }
+    true
+}
+}
+
+crate::simd::multiversion! {
+/// `y = Aᵀ (L Lᵀ)⁻¹ b` for `m` right-hand sides (`b` row-major `rows × m`; `y` row-major
+/// `k × m`; `lt` = `Lᵀ` row-major). Right-hand sides go in passes of up to 48, held as groups
+/// of eight lanes whose independent dependency chains keep the vector units busy.
+fn chunk_solve(
+    l: &[f64],
+    lt: &[f64],
+    rows: usize,
+    a: &[f64],
+    nz: &[Vec<usize>],
+    k: usize,
+    b: &[f64],
+    m: usize,
+    y: &mut [f64],
+    z: &mut Vec<[f64; 8]>,
+) {
+    let mut c0 = 0;
+    while c0 < m {
+        let groups = (m - c0).div_ceil(8).min(6);
+        match groups {
+            1 => solve_pass::<1>(l, lt, rows, a, nz, k, b, m, c0, y, z),
+            2 => solve_pass::<2>(l, lt, rows, a, nz, k, b, m, c0, y, z),
+            3 => solve_pass::<3>(l, lt, rows, a, nz, k, b, m, c0, y, z),
+            4 => solve_pass::<4>(l, lt, rows, a, nz, k, b, m, c0, y, z),
+            5 => solve_pass::<5>(l, lt, rows, a, nz, k, b, m, c0, y, z),
+            _ => solve_pass::<6>(l, lt, rows, a, nz, k, b, m, c0, y, z),
+        }
+        c0 += 8 * groups;
+    }
+}
+}
+
+#[inline(always)]
+fn solve_pass<const G: usize>(
+    l: &[f64],
+    lt: &[f64],
+    rows: usize,
+    a: &[f64],
+    nz: &[Vec<usize>],
+    k: usize,
+    b: &[f64],
+    m: usize,
+    c0: usize,
+    y: &mut [f64],
+    z: &mut Vec<[f64; 8]>,
+) {
+    let width = (8 * G).min(m - c0);
+    z.resize(rows * G, [0.0; 8]);
+    // L z = b
+    for i in 0..rows {
+        let mut acc = [[0.0; 8]; G];
+        for c in 0..width {
+            acc[c / 8][c % 8] = b[i * m + c0 + c];
+        }
+        let li = &l[i * rows..i * rows + i];
+        for (j, &x) in li.iter().enumerate() {
+            let zj = &z[j * G..(j + 1) * G];
+            for g in 0..G {
+                for p in 0..8 {
+                    acc[g][p] -= x * zj[g][p];
+                }
+            }
+        }
+        let d = 1.0 / l[i * rows + i];
+        for g in 0..G {
+            for p in 0..8 {
+                acc[g][p] *= d;
+            }
+        }
+        z[i * G..(i + 1) * G].copy_from_slice(&acc);
+    }
+    // Lᵀ y = z
+    for i in (0..rows).rev() {
+        let mut acc = [[0.0; 8]; G];
+        acc.copy_from_slice(&z[i * G..(i + 1) * G]);
+        let ci = &lt[i * rows + i + 1..(i + 1) * rows];
+        for (jj, &x) in ci.iter().enumerate() {
+            let j = i + 1 + jj;
+            let zj = &z[j * G..(j + 1) * G];
+            for g in 0..G {
+                for p in 0..8 {
+                    acc[g][p] -= x * zj[g][p];
+                }
+            }
+        }
+        let d = 1.0 / l[i * rows + i];
+        for g in 0..G {
+            for p in 0..8 {
+                acc[g][p] *= d;
+            }
+        }
+        z[i * G..(i + 1) * G].copy_from_slice(&acc);
+    }
+    // λ = Aᵀ y
+    for c in 0..k {
+        let col = &a[c * rows..(c + 1) * rows];
+        let mut acc = [[0.0; 8]; G];
+        for &r in &nz[c] {
+            let x = col[r];
+            let zr = &z[r * G..(r + 1) * G];
+            for g in 0..G {
+                for p in 0..8 {
+                    acc[g][p] += x * zr[g][p];
+                }
+            }
+        }
+        for cc in 0..width {
+            y[c * m + c0 + cc] = acc[cc / 8][cc % 8];
+        }
     }
 }
 
