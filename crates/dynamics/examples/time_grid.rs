@@ -57,14 +57,7 @@ fn main() {
         "QTR {:.4} QIT {:.4} excluded {} cyclic {:?}",
         grid.indicators[0].qtr, grid.indicators[0].qit, grid.excluded.count, grid.cyclic_coordinate
     );
-    println!(
-        "unique task evaluations {}",
-        counterpoise_dynamics::fast::UNIQUE.load(std::sync::atomic::Ordering::Relaxed)
-    );
-    println!(
-        "cholesky fallbacks {}",
-        counterpoise_dynamics::reactions::FALLBACKS.load(std::sync::atomic::Ordering::Relaxed)
-    );
+    println!("distinct moves {}", grid.distinct_moves);
     if let Some(j) = grid.indicators[0].joints.first() {
         println!("F_J1 {:.3} M_J1 {:.3}", j.force, j.moment);
     }

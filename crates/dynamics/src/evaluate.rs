@@ -106,6 +106,9 @@ pub struct GridEvaluation {
     pub reactions_minimum_norm: bool,
     /// The cyclic coordinate whose value was factored out, if the shortcut was used.
     pub cyclic_coordinate: Option<String>,
+    /// Distinct moves actually computed (tasks that differ only by a rotation about the
+    /// cyclic axis share one computation).
+    pub distinct_moves: usize,
 }
 
 impl GridEvaluation {
@@ -154,7 +157,7 @@ pub fn evaluate_grid(
         0
     };
     let mut table = StatsTable::new(tasks.len(), params.len(), ev.mech.n, joints);
-    let failures = match cyclic {
+    let (failures, distinct) = match cyclic {
         Some(cyc) => {
             crate::fast::evaluate_cyclic(&ev, cyc, &tasks, params, options.reactions, &mut table)
         }
@@ -169,7 +172,7 @@ pub fn evaluate_grid(
                     Err(f) => failures.push(f),
                 }
             }
-            failures
+            (failures, tasks.len())
         }
     };
     let names = ev.actuator_names();
@@ -183,6 +186,7 @@ pub fn evaluate_grid(
         excluded: excluded_from(&failures),
         reactions_minimum_norm: options.reactions && ev.reactions.minimum_norm,
         cyclic_coordinate: cyclic.map(|c| model.coordinates[c.coordinate].name.clone()),
+        distinct_moves: distinct,
         tasks,
     })
 }

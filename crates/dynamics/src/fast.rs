@@ -34,9 +34,6 @@ use crate::runner::Evaluator;
 use crate::symmetry::Cyclic;
 use crate::tasks::TaskSet;
 
-/// Distinct task evaluations performed by the last runs (diagnostics).
-pub static UNIQUE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-
 /// Coefficients of one sub-task: per sample, per power of `Δ` (3), per column, the motor
 /// torques (`n`) and, with reactions, the joint wrenches (`6J`).
 struct SubTaskData {
@@ -60,7 +57,7 @@ struct Work {
 type SubTaskOutcome = Result<(Vec<Vec<TaskStats>>, Vec<(usize, usize)>), Vec<TaskFailure>>;
 
 /// Runs the grid through the cyclic decomposition into `table`; returns the failures in task
-/// order.
+/// order and the number of distinct moves evaluated.
 pub(crate) fn evaluate_cyclic(
     ev: &Evaluator,
     cyc: Cyclic,
@@ -68,7 +65,7 @@ pub(crate) fn evaluate_cyclic(
     params: &ParameterSet,
     with_reactions: bool,
     table: &mut StatsTable,
-) -> Vec<TaskFailure> {
+) -> (Vec<TaskFailure>, usize) {
     let mech = &ev.mech;
     let n = mech.n;
     let ns = tasks.samples;
@@ -211,14 +208,15 @@ pub(crate) fn evaluate_cyclic(
                     })
                 })
                 .collect();
-            UNIQUE.fetch_add(unique.len(), std::sync::atomic::Ordering::Relaxed);
             let stats = task_stats(&d, &unique, ns, params.len(), na, nj);
             Ok((stats, users[st].iter().map(|u| u.0).zip(slot).collect()))
         })
         .collect();
+    let mut distinct = 0;
     for outcome in computed {
         match outcome {
             Ok((stats, assignment)) => {
+                distinct += stats.len();
                 for (w, u) in assignment {
                     table.set(w, &stats[u]);
                 }
@@ -227,7 +225,7 @@ pub(crate) fn evaluate_cyclic(
         }
     }
     failures.sort_by_key(|f| f.task);
-    failures
+    (failures, distinct)
 }
 
 crate::simd::multiversion! {

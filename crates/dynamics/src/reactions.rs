@@ -471,7 +471,6 @@ impl ReactionSolver {
                 }
                 return;
             }
-            FALLBACKS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
         let a = DMatrix::from_column_slice(rows, k, &work.a);
         let svd = a.svd(true, true);
@@ -595,9 +594,6 @@ impl ReactionSolver {
             .unwrap_or_else(|_| DMatrix::zeros(a.ncols(), b.ncols()))
     }
 }
-
-/// Samples where the fast path's Cholesky failed and the SVD fallback ran (diagnostics).
-pub static FALLBACKS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// Per-sample reaction factorisation (see [`ReactionSolver::prepare`]).
 #[derive(Clone, Debug, Default)]
