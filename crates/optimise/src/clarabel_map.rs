@@ -1,0 +1,378 @@
+//! A thin conic-problem builder over clarabel and the explicit mapping of its statuses.
+//!
+//! Problems are written as `min cᵀx` subject to blocks of rows `A x + s = b`, `s ∈ K`, with `K`
+//! a zero cone (equalities), the nonnegative orthant (`Ax ≤ b`), second-order cones
+//! (`s₀ ≥ ‖s₁…‖`) or power cones (`s₀^α s₁^(1−α) ≥ |s₂|`). Rows are built as sparse maps and
+//! converted once. Only `Solved` counts as success (DESIGN §3): every other status is returned
+//! by name so that the output says exactly why a variant was discarded.
+
+use std::collections::BTreeMap;
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use serde::Serialize;
+
+/// clarabel's termination status, one-to-one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ConicStatus {
+    Solved,
+    AlmostSolved,
+    PrimalInfeasible,
+    AlmostPrimalInfeasible,
+    DualInfeasible,
+    AlmostDualInfeasible,
+    MaxIterations,
+    MaxTime,
+    NumericalError,
+    InsufficientProgress,
+    CallbackTerminated,
+    Unsolved,
+    /// clarabel refused the problem data (dimensions or settings).
+    SetupFailed,
+}
+
+impl ConicStatus {
+    pub fn from_clarabel(s: SolverStatus) -> ConicStatus {
+        match s {
+            SolverStatus::Solved => ConicStatus::Solved,
+            SolverStatus::AlmostSolved => ConicStatus::AlmostSolved,
+            SolverStatus::PrimalInfeasible => ConicStatus::PrimalInfeasible,
+            SolverStatus::AlmostPrimalInfeasible => ConicStatus::AlmostPrimalInfeasible,
+            SolverStatus::DualInfeasible => ConicStatus::DualInfeasible,
+            SolverStatus::AlmostDualInfeasible => ConicStatus::AlmostDualInfeasible,
+            SolverStatus::MaxIterations => ConicStatus::MaxIterations,
+            SolverStatus::MaxTime => ConicStatus::MaxTime,
+            SolverStatus::NumericalError => ConicStatus::NumericalError,
+            SolverStatus::InsufficientProgress => ConicStatus::InsufficientProgress,
+            SolverStatus::CallbackTerminated => ConicStatus::CallbackTerminated,
+            SolverStatus::Unsolved => ConicStatus::Unsolved,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ConicStatus::Solved => "Solved",
+            ConicStatus::AlmostSolved => "AlmostSolved",
+            ConicStatus::PrimalInfeasible => "PrimalInfeasible",
+            ConicStatus::AlmostPrimalInfeasible => "AlmostPrimalInfeasible",
+            ConicStatus::DualInfeasible => "DualInfeasible",
+            ConicStatus::AlmostDualInfeasible => "AlmostDualInfeasible",
+            ConicStatus::MaxIterations => "MaxIterations",
+            ConicStatus::MaxTime => "MaxTime",
+            ConicStatus::NumericalError => "NumericalError",
+            ConicStatus::InsufficientProgress => "InsufficientProgress",
+            ConicStatus::CallbackTerminated => "CallbackTerminated",
+            ConicStatus::Unsolved => "Unsolved",
+            ConicStatus::SetupFailed => "SetupFailed",
+        }
+    }
+
+    /// Whether the status proves (to clarabel's tolerance) that no point satisfies the
+    /// constraints.
+    pub fn is_infeasible(self) -> bool {
+        matches!(
+            self,
+            ConicStatus::PrimalInfeasible | ConicStatus::AlmostPrimalInfeasible
+        )
+    }
+}
+
+/// One sparse row: variable → coefficient.
+pub type Row = BTreeMap<usize, f64>;
+
+#[derive(Clone, Copy, Debug)]
+enum Cone {
+    Zero(usize),
+    Nonneg(usize),
+    Soc(usize),
+    Pow(f64),
+}
+
+/// An affine expression `Σ c_j x_j + constant`.
+#[derive(Clone, Debug, Default)]
+pub struct Affine {
+    pub terms: Row,
+    pub constant: f64,
+}
+
+impl Affine {
+    pub fn constant(c: f64) -> Affine {
+        Affine {
+            terms: Row::new(),
+            constant: c,
+        }
+    }
+
+    pub fn var(j: usize) -> Affine {
+        let mut terms = Row::new();
+        terms.insert(j, 1.0);
+        Affine {
+            terms,
+            constant: 0.0,
+        }
+    }
+
+    pub fn add_scaled(&mut self, other: &Affine, s: f64) {
+        for (&j, &c) in &other.terms {
+            *self.terms.entry(j).or_insert(0.0) += s * c;
+        }
+        self.constant += s * other.constant;
+    }
+
+    pub fn add_var(&mut self, j: usize, c: f64) {
+        *self.terms.entry(j).or_insert(0.0) += c;
+    }
+
+    pub fn scaled(&self, s: f64) -> Affine {
+        let mut a = Affine::default();
+        a.add_scaled(self, s);
+        a
+    }
+
+    pub fn eval(&self, x: &[f64]) -> f64 {
+        self.constant + self.terms.iter().map(|(&j, &c)| c * x[j]).sum::<f64>()
+    }
+}
+
+/// A conic program under construction.
+#[derive(Clone, Debug, Default)]
+pub struct ConicProblem {
+    pub variables: usize,
+    pub objective: Vec<f64>,
+    rows: Vec<Row>,
+    rhs: Vec<f64>,
+    cones: Vec<Cone>,
+}
+
+/// The outcome of a solve.
+#[derive(Clone, Debug)]
+pub struct ConicSolution {
+    pub status: ConicStatus,
+    pub x: Vec<f64>,
+    pub objective: f64,
+    /// The dual objective: a lower bound on the optimum when the dual is feasible.
+    pub dual_objective: f64,
+    pub iterations: u32,
+    /// Solver runs (1 unless retried).
+    pub attempts: u32,
+}
+
+impl ConicProblem {
+    pub fn new_variable(&mut self) -> usize {
+        self.variables += 1;
+        self.objective.push(0.0);
+        self.variables - 1
+    }
+
+    /// Cone slack `s = b − A x` from the affine expression `e(x) = c + d·x`: `s = e(x)` means
+    /// row `−d`, rhs `c`.
+    fn push_expr(&mut self, e: &Affine) {
+        let row: Row = e.terms.iter().map(|(&j, &c)| (j, -c)).collect();
+        self.rows.push(row);
+        self.rhs.push(e.constant);
+    }
+
+    /// `e(x) = 0`.
+    pub fn equal_zero(&mut self, e: &Affine) {
+        self.push_expr(e);
+        self.cones.push(Cone::Zero(1));
+    }
+
+    /// `e(x) ≥ 0`.
+    pub fn nonneg(&mut self, e: &Affine) {
+        self.push_expr(e);
+        self.cones.push(Cone::Nonneg(1));
+    }
+
+    /// `head ≥ ‖tail‖`.
+    pub fn soc(&mut self, head: &Affine, tail: &[Affine]) {
+        self.push_expr(head);
+        for t in tail {
+            self.push_expr(t);
+        }
+        self.cones.push(Cone::Soc(1 + tail.len()));
+    }
+
+    /// `2·u·v ≥ ‖w‖²`, `u, v ≥ 0` (rotated cone) as `u + v ≥ ‖(u − v, √2·w)‖`.
+    pub fn rotated_soc(&mut self, u: &Affine, v: &Affine, w: &[Affine]) {
+        let mut head = u.clone();
+        head.add_scaled(v, 1.0);
+        let mut diff = u.clone();
+        diff.add_scaled(v, -1.0);
+        let mut tail = vec![diff];
+        tail.extend(w.iter().map(|e| e.scaled(std::f64::consts::SQRT_2)));
+        self.soc(&head, &tail);
+    }
+
+    /// `x^α y^(1−α) ≥ |z|`, `x, y ≥ 0`.
+    pub fn power(&mut self, x: &Affine, y: &Affine, z: &Affine, alpha: f64) {
+        self.push_expr(x);
+        self.push_expr(y);
+        self.push_expr(z);
+        self.cones.push(Cone::Pow(alpha));
+    }
+
+    pub fn rows(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Solves with clarabel (quiet, deterministic); when clarabel stops short of `Solved`
+    /// without proving infeasibility, retries with more iterations and a more cautious step,
+    /// then with a stronger regularization and more equilibration — the first `Solved` wins,
+    /// otherwise the last status is returned.
+    pub fn solve(&self, max_iter: u32) -> ConicSolution {
+        let mut last = self.solve_attempt(max_iter, 0);
+        for attempt in 1..3 {
+            if last.status == ConicStatus::Solved
+                || last.status.is_infeasible()
+                || last.status == ConicStatus::SetupFailed
+            {
+                break;
+            }
+            let retry = self.solve_attempt(max_iter, attempt);
+            last = ConicSolution {
+                attempts: attempt + 1,
+                ..retry
+            };
+        }
+        last
+    }
+
+    fn solve_attempt(&self, max_iter: u32, attempt: u32) -> ConicSolution {
+        let n = self.variables;
+        let m = self.rows.len();
+        // Column-major CSC from the rows.
+        let mut columns: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+        for (i, row) in self.rows.iter().enumerate() {
+            for (&j, &c) in row {
+                if c != 0.0 {
+                    columns[j].push((i, c));
+                }
+            }
+        }
+        let mut colptr = Vec::with_capacity(n + 1);
+        let mut rowval = Vec::new();
+        let mut nzval = Vec::new();
+        colptr.push(0);
+        for col in &columns {
+            for &(i, c) in col {
+                rowval.push(i);
+                nzval.push(c);
+            }
+            colptr.push(rowval.len());
+        }
+        let a = CscMatrix::new(m, n, colptr, rowval, nzval);
+        let p = CscMatrix::zeros((n, n));
+        let cones: Vec<SupportedConeT<f64>> = self
+            .cones
+            .iter()
+            .map(|c| match *c {
+                Cone::Zero(k) => SupportedConeT::ZeroConeT(k),
+                Cone::Nonneg(k) => SupportedConeT::NonnegativeConeT(k),
+                Cone::Soc(k) => SupportedConeT::SecondOrderConeT(k),
+                Cone::Pow(a) => SupportedConeT::PowerConeT(a),
+            })
+            .collect();
+        let mut settings = DefaultSettings {
+            verbose: false,
+            max_iter,
+            ..DefaultSettings::default()
+        };
+        if attempt >= 1 {
+            settings.max_iter = max_iter.saturating_mul(3);
+            settings.max_step_fraction = 0.9;
+            settings.equilibrate_max_iter = 50;
+        }
+        if attempt >= 2 {
+            settings.static_regularization_constant = 1e-7;
+            settings.iterative_refinement_max_iter = 50;
+            settings.equilibrate_min_scaling = 1e-6;
+            settings.equilibrate_max_scaling = 1e6;
+        }
+        let failed = || ConicSolution {
+            status: ConicStatus::SetupFailed,
+            x: vec![0.0; n],
+            objective: f64::NAN,
+            dual_objective: f64::NAN,
+            iterations: 0,
+            attempts: 1,
+        };
+        let Ok(mut solver) =
+            DefaultSolver::new(&p, &self.objective, &a, &self.rhs, &cones, settings)
+        else {
+            return failed();
+        };
+        solver.solve();
+        let s = &solver.solution;
+        ConicSolution {
+            status: ConicStatus::from_clarabel(s.status),
+            x: s.x.clone(),
+            objective: s.obj_val,
+            dual_objective: s.obj_val_dual,
+            iterations: s.iterations,
+            attempts: 1,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_socp() {
+        // min t s.t. t ≥ ‖(x − 1, y − 2)‖, x + y = 0 → distance from (1, 2) to the line: 3/√2.
+        let mut p = ConicProblem::default();
+        let (x, y, t) = (p.new_variable(), p.new_variable(), p.new_variable());
+        p.objective[t] = 1.0;
+        let mut sum = Affine::var(x);
+        sum.add_var(y, 1.0);
+        p.equal_zero(&sum);
+        let mut dx = Affine::var(x);
+        dx.constant = -1.0;
+        let mut dy = Affine::var(y);
+        dy.constant = -2.0;
+        p.soc(&Affine::var(t), &[dx, dy]);
+        let s = p.solve(100);
+        assert_eq!(s.status, ConicStatus::Solved);
+        assert!((s.objective - 3.0 / 2f64.sqrt()).abs() < 1e-7);
+    }
+
+    #[test]
+    fn power_cone_and_infeasible() {
+        // min p s.t. p^(3/5) ≥ m, m = 8 → p = 32.
+        let mut p = ConicProblem::default();
+        let (pv, m) = (p.new_variable(), p.new_variable());
+        p.objective[pv] = 1.0;
+        let mut e = Affine::var(m);
+        e.constant = -8.0;
+        p.equal_zero(&e);
+        p.power(
+            &Affine::var(pv),
+            &Affine::constant(1.0),
+            &Affine::var(m),
+            0.6,
+        );
+        let s = p.solve(100);
+        assert_eq!(s.status, ConicStatus::Solved);
+        assert!((s.x[pv] - 32.0).abs() < 1e-5, "{}", s.x[pv]);
+
+        let mut q = ConicProblem::default();
+        let x = q.new_variable();
+        q.nonneg(&Affine::var(x).scaled(-1.0).tap_const(-1.0));
+        q.nonneg(&Affine::var(x));
+        let s = q.solve(100);
+        assert!(s.status.is_infeasible(), "{:?}", s.status);
+    }
+
+    trait TapConst {
+        fn tap_const(self, c: f64) -> Self;
+    }
+    impl TapConst for Affine {
+        fn tap_const(mut self, c: f64) -> Self {
+            self.constant += c;
+            self
+        }
+    }
+}

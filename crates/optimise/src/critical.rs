@@ -1,0 +1,834 @@
+//! The critical-task iteration (paper Proc-5…8) over many variants at once.
+//!
+//! Every variant starts from the unbalanced robot's critical tasks (each actuator's CRT, the
+//! CPT of each actuator with a peak limit; for minimax also the QTR task). A pass solves the
+//! relaxation on the working set (lower bound), refines the recovered point with the exact
+//! objective, realizes the springs, and then *all* tasks are evaluated with the dynamics crate
+//! — one batched grid evaluation for every variant still iterating. Tasks that are now critical
+//! and not yet in the working set are added and the variant is solved again; it stops when no
+//! new critical task appears (converged) or after `max_iterations` passes.
+//!
+//! Working-set objective: each actuator's largest RMS over the working-set tasks (RMS*) or the
+//! largest per-task total RMS (minimax). It never exceeds the all-task objective at the same
+//! point, so the relaxation's bound on the final working set bounds the true optimum.
+
+use std::collections::BTreeSet;
+
+use counterpoise_balance::linear::solve;
+use counterpoise_balance::{Attachment, Status, VariantResult};
+use counterpoise_dynamics::params::{Counterweight, ParameterSet, Spring, Variant};
+use counterpoise_dynamics::runner::Workspace;
+use counterpoise_dynamics::{EvaluateOptions, Evaluator, Indicators, evaluate_grid};
+use nalgebra::DVector;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::context::Context;
+use crate::problem::{CwPhysical, Objective, VariantProblem};
+use crate::refine::{counterweight_directions, merit, project_fixed, refine};
+use crate::relaxation::solve_relaxation;
+use crate::result::{
+    FreeParameter, Iteration, OptimisedCounterweight, OptimisedSpring, OptimisedStatus,
+    OptimisedVariant,
+};
+use crate::springs::{SpringValues, realize_springs};
+use crate::verify::verify;
+
+/// Settings of the optimisation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OptimiseOptions {
+    pub objective: Objective,
+    /// Most passes of the critical-task loop.
+    pub max_iterations: usize,
+    /// Relative gap below which the relaxation's recovered point is accepted without local
+    /// refinement.
+    pub gap_tolerance: f64,
+    /// Starts of the spring realization per pass (the final choice uses four times as many).
+    pub spring_starts: usize,
+    /// Compute joint reactions in the final all-task evaluation (F_j, M_j, ΔR).
+    pub final_reactions: bool,
+    /// clarabel iteration limit.
+    pub solver_iterations: u32,
+}
+
+impl Default for OptimiseOptions {
+    fn default() -> Self {
+        OptimiseOptions {
+            objective: Objective::RmsStar,
+            max_iterations: 8,
+            gap_tolerance: 1e-3,
+            spring_starts: 4,
+            final_reactions: true,
+            solver_iterations: 200,
+        }
+    }
+}
+
+/// A variant in the loop.
+struct Run {
+    elements: Vec<String>,
+    class: counterpoise_balance::Class,
+    free_components: Vec<Vec<(String, f64)>>,
+    problem: Option<VariantProblem>,
+    working: Vec<usize>,
+    iterations: Vec<Iteration>,
+    state: State,
+    candidate: Option<Candidate>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum State {
+    Running,
+    Converged,
+    Stopped,
+    Discarded(String),
+}
+
+#[derive(Clone, Debug)]
+struct Candidate {
+    x: DVector<f64>,
+    cws: Vec<CwPhysical>,
+    springs: Vec<SpringValues>,
+    lower_bound: f64,
+    working_value: f64,
+    relaxation_status: crate::clarabel_map::ConicStatus,
+    relaxation_iterations: u32,
+    gap_before: f64,
+}
+
+/// Optimises one balanced variant (see [`optimise_all`]).
+pub fn optimise_variant(
+    ctx: &Context,
+    variant: &VariantResult,
+    options: &OptimiseOptions,
+) -> OptimisedVariant {
+    optimise_all(ctx, std::slice::from_ref(variant), options)
+        .pop()
+        .expect("one result per balanced variant")
+}
+
+/// Optimises every `balanced` variant of `variants` (others are skipped), in parallel on the
+/// current rayon pool; results are in input order and do not depend on the thread count.
+pub fn optimise_all(
+    ctx: &Context,
+    variants: &[VariantResult],
+    options: &OptimiseOptions,
+) -> Vec<OptimisedVariant> {
+    let mut runs: Vec<Run> = variants
+        .iter()
+        .filter(|v| v.status == Status::Balanced)
+        .map(|v| new_run(ctx, v, options))
+        .collect();
+
+    for _pass in 0..options.max_iterations.max(1) {
+        let active: Vec<usize> = (0..runs.len())
+            .filter(|&k| runs[k].state == State::Running)
+            .collect();
+        if active.is_empty() {
+            break;
+        }
+        let union: Vec<usize> = active
+            .iter()
+            .flat_map(|&k| runs[k].working.iter().copied())
+            .collect::<BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        let (_, failures) = ctx.torques.get(&ctx.model, &ctx.tasks, &union);
+        let failed: BTreeSet<usize> = failures.iter().map(|f| f.0).collect();
+
+        let outcomes: Vec<(usize, Result<Candidate, String>)> = active
+            .par_iter()
+            .map(|&k| (k, step(ctx, &runs[k], &failed, options)))
+            .collect();
+        let mut evaluated: Vec<usize> = Vec::new();
+        for (k, outcome) in outcomes {
+            match outcome {
+                Ok(c) => {
+                    runs[k].candidate = Some(c);
+                    evaluated.push(k);
+                }
+                Err(reason) => runs[k].state = State::Discarded(reason),
+            }
+        }
+        if evaluated.is_empty() {
+            continue;
+        }
+        let dyn_variants: Vec<Variant> = evaluated
+            .iter()
+            .map(|&k| {
+                dynamics_variant(
+                    runs[k].problem.as_ref().expect("problem"),
+                    runs[k].candidate.as_ref().expect("candidate"),
+                )
+            })
+            .collect();
+        let indicators = match grid_indicators(ctx, &dyn_variants, false) {
+            Ok(i) => i,
+            Err(e) => {
+                for &k in &evaluated {
+                    runs[k].state = State::Discarded(format!("dynamics evaluation failed: {e}"));
+                }
+                continue;
+            }
+        };
+        for (&k, ind) in evaluated.iter().zip(&indicators) {
+            let run = &mut runs[k];
+            let problem = run.problem.as_ref().expect("problem");
+            let cand = run.candidate.as_ref().expect("candidate");
+            let critical = critical_tasks(ctx, problem, ind, options.objective);
+            let added: Vec<usize> = critical
+                .into_iter()
+                .filter(|w| !run.working.contains(w))
+                .collect::<BTreeSet<_>>()
+                .into_iter()
+                .collect();
+            run.iterations.push(Iteration {
+                tasks: run.working.len(),
+                lower_bound: cand.lower_bound,
+                objective_working: cand.working_value,
+                objective_all: objective_of(ind, options.objective),
+                added: added.iter().map(|&w| ctx.pair(w)).collect(),
+                relaxation_status: cand.relaxation_status,
+                relaxation_iterations: cand.relaxation_iterations,
+                gap_before_refinement: cand.gap_before,
+            });
+            if added.is_empty() {
+                run.state = State::Converged;
+            } else {
+                run.working.extend(added);
+            }
+        }
+    }
+    for run in &mut runs {
+        if run.state == State::Running {
+            run.state = State::Stopped;
+        }
+    }
+    finish(ctx, runs, options)
+}
+
+fn new_run(ctx: &Context, v: &VariantResult, options: &OptimiseOptions) -> Run {
+    let set: Vec<usize> = v.elements.iter().map(|e| e.entry).collect();
+    let solution = solve(&ctx.basis, &set);
+    let problem = VariantProblem::new(
+        &ctx.model,
+        &ctx.catalogue,
+        &ctx.bounds,
+        &set,
+        solution,
+        |b| ctx.torques.slot_of(b),
+    );
+    let mut working = BTreeSet::new();
+    for a in &ctx.unbalanced.actuators {
+        if let Some(w) = ctx.task_index(a.crt) {
+            working.insert(w);
+        }
+    }
+    let limits = ctx
+        .model
+        .balancing
+        .as_ref()
+        .map(|b| b.peak_limits.clone())
+        .unwrap_or_default();
+    for (n, a) in ctx.unbalanced.actuators.iter().enumerate() {
+        if limits.get(n).copied().flatten().is_some()
+            && let Some(w) = ctx.task_index(a.cpt)
+        {
+            working.insert(w);
+        }
+    }
+    if options.objective == Objective::Minimax
+        && let Some(w) = ctx.task_index(ctx.unbalanced.qtr_task)
+    {
+        working.insert(w);
+    }
+    let (problem, state) = match problem {
+        Ok(p) => (Some(p), State::Running),
+        Err(e) => (None, State::Discarded(e)),
+    };
+    Run {
+        elements: v.elements.iter().map(|e| e.label.clone()).collect(),
+        class: v.class,
+        free_components: v
+            .free_directions
+            .iter()
+            .map(|f| f.components.clone())
+            .collect(),
+        problem,
+        working: working.into_iter().collect(),
+        iterations: Vec::new(),
+        state,
+        candidate: None,
+    }
+}
+
+/// One pass for one variant: relaxation, recovery, refinement, springs.
+fn step(
+    ctx: &Context,
+    run: &Run,
+    failed: &BTreeSet<usize>,
+    options: &OptimiseOptions,
+) -> Result<Candidate, String> {
+    let problem = run
+        .problem
+        .as_ref()
+        .expect("running variants have a problem");
+    if let Some(w) = run.working.iter().find(|w| failed.contains(w)) {
+        return Err(format!(
+            "the kinematics of critical task {:?} failed",
+            ctx.pair(*w)
+        ));
+    }
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+    let relaxed = solve_relaxation(
+        problem,
+        &tasks,
+        options.objective,
+        options.solver_iterations,
+    );
+    let status = relaxed.solution.status;
+    if status.is_infeasible() {
+        return Err(format!(
+            "the bounds and peak limits cannot all be met: the convex relaxation is infeasible \
+             (clarabel: {})",
+            status.name()
+        ));
+    }
+    if status != crate::clarabel_map::ConicStatus::Solved {
+        return Err(format!(
+            "the relaxation was not solved (clarabel: {})",
+            status.name()
+        ));
+    }
+    let lower = relaxed.bound;
+    let z_relaxed = project_fixed(problem, &relaxed.z);
+    let scale = lower.abs().max(1e-9);
+    let (_, v0, viol0) = merit(problem, &tasks, options.objective, &z_relaxed, scale);
+    let gap_before = if viol0 <= 0.0 && v0.is_finite() {
+        ((v0 - lower) / v0.max(1e-300)).max(0.0)
+    } else {
+        f64::INFINITY
+    };
+    let z = if gap_before <= options.gap_tolerance {
+        z_relaxed
+    } else {
+        let dirs = counterweight_directions(problem);
+        let refined = refine(problem, &tasks, options.objective, &z_relaxed, &dirs, scale);
+        if !refined.feasible {
+            return Err(format!(
+                "no parameters found that meet every bound and peak limit (smallest relative \
+                 violation {:.2e})",
+                refined.violation
+            ));
+        }
+        refined.z
+    };
+    let x = problem.lifted(&z);
+    let (springs, note) = realize_springs(
+        problem,
+        &ctx.basis.unbalanced,
+        &x,
+        options.spring_starts,
+        false,
+    );
+    let (springs, x_full) = match springs.into_iter().next() {
+        Some(found) => found,
+        None if !problem.counterweights.is_empty() => {
+            // The motors' best counterweights leave no admissible springs: move both.
+            let (joint, _) = realize_springs(
+                problem,
+                &ctx.basis.unbalanced,
+                &x,
+                options.spring_starts,
+                true,
+            );
+            joint.into_iter().next().ok_or(note)?
+        }
+        None => return Err(note),
+    };
+    let cws = problem.cw_physical(&x_full);
+    let value = problem
+        .evaluate(&cws, &tasks)
+        .objective(options.objective, problem.actuators);
+    Ok(Candidate {
+        x: x_full,
+        cws,
+        springs,
+        lower_bound: lower,
+        working_value: value,
+        relaxation_status: status,
+        relaxation_iterations: relaxed.solution.iterations,
+        gap_before,
+    })
+}
+
+fn dynamics_variant(problem: &VariantProblem, c: &Candidate) -> Variant {
+    Variant {
+        counterweights: problem
+            .counterweights
+            .iter()
+            .zip(&c.cws)
+            .map(|(slot, p)| Counterweight {
+                body: slot.body,
+                mass: p.mass,
+                position: p.offset(),
+            })
+            .collect(),
+        springs: c
+            .springs
+            .iter()
+            .map(|s| Spring {
+                body: s.body,
+                other: match s.other {
+                    Attachment::Base => None,
+                    Attachment::Body(b) => Some(b),
+                },
+                stiffness: s.stiffness,
+                anchor: s.anchor_a,
+                other_anchor: s.anchor_b,
+            })
+            .collect(),
+    }
+}
+
+// Built from the default and then set: fields the dynamics crate adds keep their defaults.
+#[allow(clippy::field_reassign_with_default)]
+fn grid_indicators(
+    ctx: &Context,
+    variants: &[Variant],
+    reactions: bool,
+) -> Result<Vec<Indicators>, String> {
+    let params = ParameterSet::from_variants(&ctx.model, variants).map_err(|e| e.to_string())?;
+    let mut evaluate_options = EvaluateOptions::default();
+    evaluate_options.reactions = reactions;
+    let grid = evaluate_grid(&ctx.model, &params, &evaluate_options).map_err(|e| e.to_string())?;
+    Ok(grid.indicators)
+}
+
+/// The objective over all tasks from a variant's indicators.
+pub fn objective_of(ind: &Indicators, objective: Objective) -> f64 {
+    match objective {
+        Objective::RmsStar => {
+            let n = ind.actuators.len().max(1) as f64;
+            (ind.actuators
+                .iter()
+                .map(|a| a.crt_rms * a.crt_rms)
+                .sum::<f64>()
+                / n)
+                .sqrt()
+        }
+        Objective::Minimax => ind.qtr,
+    }
+}
+
+fn critical_tasks(
+    ctx: &Context,
+    problem: &VariantProblem,
+    ind: &Indicators,
+    objective: Objective,
+) -> Vec<usize> {
+    let mut out = Vec::new();
+    for (n, a) in ind.actuators.iter().enumerate() {
+        if objective == Objective::RmsStar {
+            out.extend(ctx.task_index(a.crt));
+        }
+        if problem.peak_limits.get(n).copied().flatten().is_some() {
+            out.extend(ctx.task_index(a.cpt));
+        }
+    }
+    if objective == Objective::Minimax {
+        out.extend(ctx.task_index(ind.qtr_task));
+    }
+    out
+}
+
+/// Peak joint reaction forces and moments, one entry per joint each.
+type JointPeaks = (Vec<f64>, Vec<f64>);
+
+/// Peak joint reactions `(F_j, M_j)` of each variant over the given tasks.
+fn reaction_peaks(ctx: &Context, variants: &[Variant], tasks: &[usize]) -> Option<Vec<JointPeaks>> {
+    let ev = Evaluator::new(&ctx.model).ok()?;
+    let params = ParameterSet::from_variants(&ctx.model, variants).ok()?;
+    let columns: Vec<usize> = (0..params.len()).collect();
+    let nj = ctx.model.joints.len();
+    let per_task: Vec<Option<Vec<JointPeaks>>> = tasks
+        .par_iter()
+        .map_init(Workspace::default, |ws, &w| {
+            let (i, j) = ctx.tasks.pair(w);
+            let mut q = ev.solve_point(&ctx.tasks.points[i]).ok()?;
+            let mut acc = vec![(vec![0.0; nj], vec![0.0; nj]); columns.len()];
+            ev.run_move(
+                &ctx.tasks.points[i],
+                &ctx.tasks.points[j],
+                ctx.tasks.duration,
+                ctx.tasks.samples,
+                &mut q,
+                &params,
+                &columns,
+                true,
+                ws,
+                |_, view| {
+                    for (c, a) in acc.iter_mut().enumerate() {
+                        let r = &view.reactions[c];
+                        for (p, f) in a.0.iter_mut().zip(r.force_magnitudes()) {
+                            *p = f64::max(*p, f);
+                        }
+                        for (p, m) in a.1.iter_mut().zip(r.moment_magnitudes()) {
+                            *p = f64::max(*p, m);
+                        }
+                    }
+                },
+            )
+            .ok()?;
+            Some(acc)
+        })
+        .collect();
+    let mut total = vec![(vec![0.0; nj], vec![0.0; nj]); columns.len()];
+    for t in per_task.into_iter().flatten() {
+        for (tot, a) in total.iter_mut().zip(t) {
+            for (x, y) in tot.0.iter_mut().zip(a.0) {
+                *x = f64::max(*x, y);
+            }
+            for (x, y) in tot.1.iter_mut().zip(a.1) {
+                *x = f64::max(*x, y);
+            }
+        }
+    }
+    Some(total)
+}
+
+/// ΔR (paper Eqs. 17–21): weighted positive percentage increases of the peak joint reactions.
+pub fn delta_r(unbalanced: &Indicators, force: &[f64], moment: &[f64]) -> Option<f64> {
+    if unbalanced.joints.is_empty() {
+        return None;
+    }
+    let sf: f64 = unbalanced.joints.iter().map(|j| j.force).sum();
+    let sm: f64 = unbalanced.joints.iter().map(|j| j.moment).sum();
+    let mut total = 0.0;
+    for (k, j) in unbalanced.joints.iter().enumerate() {
+        if j.force > 0.0 && sf > 0.0 {
+            let d = ((force[k] - j.force) / j.force * 100.0).max(0.0);
+            total += j.force / sf * d;
+        }
+        if j.moment > 0.0 && sm > 0.0 {
+            let d = ((moment[k] - j.moment) / j.moment * 100.0).max(0.0);
+            total += j.moment / sm * d;
+        }
+    }
+    Some(total)
+}
+
+/// Interval of coordinate `k` (others held) over which the convex lifted bounds hold.
+fn interval(problem: &VariantProblem, x: &DVector<f64>, direction: &DVector<f64>) -> [f64; 2] {
+    let ok = |t: f64| {
+        let xt = x + direction * t;
+        problem.bound_violations(&xt).iter().all(|&v| v <= 1e-12)
+    };
+    let mut ends = [0.0; 2];
+    for (side, sign) in [(0usize, -1.0f64), (1, 1.0)] {
+        let mut inside = 0.0;
+        let mut step = 1e-6;
+        let mut outside = None;
+        while step < 1e12 {
+            if ok(sign * step) {
+                inside = step;
+                step *= 2.0;
+            } else {
+                outside = Some(step);
+                break;
+            }
+        }
+        ends[side] = match outside {
+            None => sign * f64::INFINITY,
+            Some(mut out) => {
+                for _ in 0..80 {
+                    let mid = 0.5 * (inside + out);
+                    if ok(sign * mid) {
+                        inside = mid;
+                    } else {
+                        out = mid;
+                    }
+                }
+                sign * inside
+            }
+        };
+    }
+    ends
+}
+
+fn free_parameters(
+    problem: &VariantProblem,
+    components: &[Vec<(String, f64)>],
+    x: &DVector<f64>,
+) -> Vec<FreeParameter> {
+    let n = &problem.nullspace;
+    let d = n.ncols();
+    if d == 0 {
+        return Vec::new();
+    }
+    // Coordinates of x in the family: least squares on N (exact: x is in the family).
+    let delta = x - &problem.particular;
+    let z = n
+        .clone()
+        .svd(true, true)
+        .solve(&delta, 1e-12)
+        .unwrap_or_else(|_| DVector::zeros(d));
+    let cw_rows = problem.cw_rows();
+    let scale = &problem.solution.column_scale;
+    (0..d)
+        .map(|k| {
+            let col = n.column(k);
+            // Normalise like the balance crate: largest scaled component → ±1.
+            let (big, _) = (0..col.len()).fold((0, 0.0f64), |acc, j| {
+                let v = (col[j] * scale[j]).abs();
+                if v > acc.1 { (j, v) } else { acc }
+            });
+            let norm = col[big];
+            let direction: DVector<f64> = col.map(|v| v / norm);
+            let value = z[k] * norm;
+            let [lo, hi] = interval(problem, x, &direction);
+            FreeParameter {
+                components: components.get(k).cloned().unwrap_or_default(),
+                value,
+                interval: [value + lo, value + hi],
+                moves_counterweights: cw_rows
+                    .iter()
+                    .any(|&r| (col[r] * scale[r]).abs() > 1e-9 * (col[big] * scale[big]).abs()),
+            }
+        })
+        .collect()
+}
+
+/// The chosen springs, the lifted point with them, and their ΔR on the reaction tasks.
+type SpringChoice = (Vec<SpringValues>, DVector<f64>, Option<f64>);
+
+/// Spring choice by ΔR, final all-task evaluation, verification and the output records.
+fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<OptimisedVariant> {
+    // Reaction tasks: the critical tasks plus the unbalanced joints' critical tasks.
+    let mut joint_tasks = BTreeSet::new();
+    for j in &ctx.unbalanced.joints {
+        joint_tasks.extend(ctx.task_index(j.force_task));
+        joint_tasks.extend(ctx.task_index(j.moment_task));
+    }
+    let choices: Vec<Option<SpringChoice>> = runs
+        .par_iter()
+        .map(|run| {
+            let cand = run.candidate.as_ref()?;
+            if !matches!(run.state, State::Converged | State::Stopped) {
+                return None;
+            }
+            let problem = run.problem.as_ref()?;
+            if problem.springs.is_empty() {
+                return Some((Vec::new(), cand.x.clone(), None));
+            }
+            let (found, _) = realize_springs(
+                problem,
+                &ctx.basis.unbalanced,
+                &cand.x,
+                options.spring_starts * 4,
+                false,
+            );
+            let mut options_found: Vec<crate::springs::Realized> = found;
+            if options_found.is_empty() {
+                options_found.push((cand.springs.clone(), cand.x.clone()));
+            }
+            let variants: Vec<Variant> = options_found
+                .iter()
+                .map(|(s, _)| {
+                    dynamics_variant(
+                        problem,
+                        &Candidate {
+                            springs: s.clone(),
+                            ..cand.clone()
+                        },
+                    )
+                })
+                .collect();
+            let tasks: Vec<usize> = joint_tasks
+                .iter()
+                .copied()
+                .chain(run.working.iter().copied())
+                .collect::<BTreeSet<_>>()
+                .into_iter()
+                .collect();
+            let peaks = reaction_peaks(ctx, &variants, &tasks);
+            let scores: Vec<Option<f64>> = match &peaks {
+                Some(p) => p
+                    .iter()
+                    .map(|(f, m)| delta_r(&ctx.unbalanced, f, m))
+                    .collect(),
+                None => vec![None; variants.len()],
+            };
+            let best = (0..options_found.len())
+                .min_by(|&a, &b| {
+                    let sa = scores[a].unwrap_or(f64::INFINITY);
+                    let sb = scores[b].unwrap_or(f64::INFINITY);
+                    sa.total_cmp(&sb).then(a.cmp(&b))
+                })
+                .unwrap_or(0);
+            let (s, x) = options_found.swap_remove(best);
+            Some((s, x, scores[best]))
+        })
+        .collect();
+    for (run, choice) in runs.iter_mut().zip(&choices) {
+        if let (Some(c), Some((s, x, _))) = (run.candidate.as_mut(), choice) {
+            c.springs = s.clone();
+            c.x = x.clone();
+        }
+    }
+    // Final evaluation over all tasks, batched.
+    let finals: Vec<usize> = (0..runs.len())
+        .filter(|&k| {
+            runs[k].candidate.is_some()
+                && matches!(runs[k].state, State::Converged | State::Stopped)
+        })
+        .collect();
+    let variants: Vec<Variant> = finals
+        .iter()
+        .map(|&k| {
+            dynamics_variant(
+                runs[k].problem.as_ref().expect("problem"),
+                runs[k].candidate.as_ref().expect("candidate"),
+            )
+        })
+        .collect();
+    let final_indicators = if variants.is_empty() {
+        Ok(Vec::new())
+    } else {
+        grid_indicators(ctx, &variants, options.final_reactions)
+    };
+    let mut indicators_of: Vec<Option<Result<Indicators, String>>> = vec![None; runs.len()];
+    for (n, &k) in finals.iter().enumerate() {
+        indicators_of[k] = Some(match &final_indicators {
+            Ok(v) => Ok(v[n].clone()),
+            Err(e) => Err(e.clone()),
+        });
+    }
+
+    runs.into_iter()
+        .zip(choices)
+        .zip(indicators_of)
+        .map(|((run, choice), ind)| record(ctx, run, choice.and_then(|c| c.2), ind, options))
+        .collect()
+}
+
+fn record(
+    ctx: &Context,
+    run: Run,
+    delta_r_estimate: Option<f64>,
+    indicators: Option<Result<Indicators, String>>,
+    options: &OptimiseOptions,
+) -> OptimisedVariant {
+    let mut out = OptimisedVariant {
+        elements: run.elements.clone(),
+        class: run.class,
+        status: OptimisedStatus::Discarded,
+        reason: None,
+        objective_kind: options.objective,
+        objective: None,
+        lower_bound: None,
+        gap: None,
+        residual: None,
+        converged: run.state == State::Converged,
+        iterations: run.iterations.clone(),
+        critical_tasks: run.working.iter().map(|&w| ctx.pair(w)).collect(),
+        counterweights: Vec::new(),
+        springs: Vec::new(),
+        free_parameters: Vec::new(),
+        delta_r_estimate,
+        verification: None,
+        indicators: None,
+    };
+    if let State::Discarded(reason) = &run.state {
+        out.reason = Some(reason.clone());
+        return out;
+    }
+    let (Some(problem), Some(cand)) = (run.problem.as_ref(), run.candidate.as_ref()) else {
+        out.reason = Some("no candidate parameters were produced".into());
+        return out;
+    };
+    let name = |b: usize| ctx.model.bodies[b].name.clone();
+    out.counterweights = problem
+        .counterweights
+        .iter()
+        .zip(&cand.cws)
+        .map(|(slot, p)| OptimisedCounterweight {
+            label: slot.label.clone(),
+            body: name(slot.body),
+            mass: p.mass,
+            offset: p.offset(),
+            radius: p.radius(),
+        })
+        .collect();
+    out.springs = cand
+        .springs
+        .iter()
+        .map(|s| OptimisedSpring {
+            label: s.label.clone(),
+            body: name(s.body),
+            other: match s.other {
+                Attachment::Base => "base".into(),
+                Attachment::Body(b) => name(b),
+            },
+            other_attachment: Some(s.other),
+            stiffness: s.stiffness,
+            anchor_a: s.anchor_a,
+            anchor_b: s.anchor_b,
+        })
+        .collect();
+    out.free_parameters = free_parameters(problem, &run.free_components, &cand.x);
+    out.lower_bound = Some(cand.lower_bound);
+    let ind = match indicators {
+        Some(Ok(i)) => i,
+        Some(Err(e)) => {
+            out.reason = Some(format!("final dynamics evaluation failed: {e}"));
+            return out;
+        }
+        None => {
+            out.reason = Some("no final evaluation".into());
+            return out;
+        }
+    };
+    let objective = objective_of(&ind, options.objective);
+    out.objective = Some(objective);
+    out.gap = Some(((objective - cand.lower_bound) / objective.abs().max(1e-300)).max(0.0));
+    let report = verify(problem, &ctx.checks, &cand.cws, &cand.springs, &ind);
+    out.residual = Some(report.balance_residual);
+    let passed = report.passed;
+    if !passed {
+        let mut why = Vec::new();
+        if !report.balance_passed {
+            why.push(format!(
+                "balance residual {:.2e} exceeds 1e-9",
+                report.balance_residual
+            ));
+        }
+        if !report.bounds_passed {
+            why.push(format!(
+                "a bound is exceeded (relative {:.2e})",
+                report.bound_excess
+            ));
+        }
+        if !report.peaks_passed {
+            for p in &report.peaks {
+                if let Some(l) = p.limit
+                    && p.peak > l
+                {
+                    why.push(format!(
+                        "{} peaks at {:.3} N·m over all tasks (limit {l})",
+                        p.actuator, p.peak
+                    ));
+                }
+            }
+        }
+        out.reason = Some(format!("verification failed: {}", why.join("; ")));
+    } else {
+        out.status = OptimisedStatus::Feasible;
+        if run.state == State::Stopped {
+            out.reason = None;
+        }
+    }
+    out.verification = Some(report);
+    out.indicators = Some(ind);
+    out
+}

@@ -1,0 +1,291 @@
+//! Local refinement in physical variables: Nelder–Mead on the free coordinates that move the
+//! counterweights, with the exact objective (`S = μμᵀ/m`, `J ∝ m^{5/3}`) and an exact penalty
+//! for the constraints.
+//!
+//! The families are small (a handful of free coordinates), the objective is cheap (a weighted
+//! sum of precomputed torque columns) and non-smooth (a maximum over tasks), so a
+//! derivative-free simplex method is simple and adequate. Restarts from the best point with a
+//! smaller simplex guard against premature collapse. The best *feasible* point seen is kept,
+//! so the result never trades feasibility for objective.
+
+use std::sync::Arc;
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::problem::{Objective, VariantProblem};
+use crate::torque::TaskTorques;
+
+/// The best point found.
+#[derive(Clone, Debug)]
+pub struct Refined {
+    pub z: DVector<f64>,
+    /// Working-set objective at `z` (N·m).
+    pub value: f64,
+    /// Whether every constraint holds at `z`.
+    pub feasible: bool,
+    /// Largest relative violation at `z` (≤ 0 when feasible).
+    pub violation: f64,
+    pub evaluations: usize,
+}
+
+/// Lifted rows fixed by equal lower and upper bounds (a mass override `[m, m]`), with their
+/// value: linear equalities the refinement keeps exactly by moving only along directions that
+/// leave them unchanged.
+pub fn fixed_rows(problem: &VariantProblem) -> Vec<(usize, f64)> {
+    problem
+        .counterweights
+        .iter()
+        .filter(|c| c.bounds.mass[0] == c.bounds.mass[1])
+        .map(|c| (c.column, c.bounds.mass[0]))
+        .chain(
+            problem
+                .springs
+                .iter()
+                .filter(|s| s.bounds.stiffness[0] == s.bounds.stiffness[1])
+                .map(|s| (s.column, s.bounds.stiffness[0])),
+        )
+        .collect()
+}
+
+/// The point nearest to `z` (least change) that meets the fixed rows exactly.
+pub fn project_fixed(problem: &VariantProblem, z: &DVector<f64>) -> DVector<f64> {
+    let fixed = fixed_rows(problem);
+    if fixed.is_empty() {
+        return z.clone();
+    }
+    let d = problem.dim();
+    let a = DMatrix::from_fn(fixed.len(), d, |i, k| problem.nullspace[(fixed[i].0, k)]);
+    let x = problem.lifted(z);
+    let r = DVector::from_iterator(fixed.len(), fixed.iter().map(|&(row, v)| v - x[row]));
+    match a.clone().svd(true, true).solve(&r, 1e-12) {
+        Ok(dz) => z + dz,
+        Err(_) => z.clone(),
+    }
+}
+
+/// Basis of the directions of `z` that keep the fixed rows.
+fn free_subspace(problem: &VariantProblem) -> DMatrix<f64> {
+    let d = problem.dim();
+    let fixed = fixed_rows(problem);
+    if fixed.is_empty() || d == 0 {
+        return DMatrix::identity(d, d);
+    }
+    let mut a = DMatrix::zeros(d.max(fixed.len()), d);
+    for (i, &(row, _)) in fixed.iter().enumerate() {
+        for k in 0..d {
+            a[(i, k)] = problem.nullspace[(row, k)];
+        }
+    }
+    let svd = a.svd(false, true);
+    let v_t = svd.v_t.expect("V computed");
+    let smax = svd.singular_values.iter().fold(0.0f64, |x, &y| x.max(y));
+    let cols: Vec<DVector<f64>> = (0..svd.singular_values.len())
+        .filter(|&k| svd.singular_values[k] <= 1e-12 * smax.max(f64::MIN_POSITIVE))
+        .map(|k| v_t.row(k).transpose())
+        .collect();
+    if cols.is_empty() {
+        DMatrix::zeros(d, 0)
+    } else {
+        DMatrix::from_columns(&cols)
+    }
+}
+
+/// Directions of `z` that move the counterweights while keeping the fixed rows: an orthonormal
+/// basis of the row space of `N` restricted to counterweight rows, within the free subspace
+/// (scaled so that a unit step changes a mass or `m·r` by about its bound).
+pub fn counterweight_directions(problem: &VariantProblem) -> DMatrix<f64> {
+    let rows = problem.cw_rows();
+    let basis = free_subspace(problem);
+    let d = basis.ncols();
+    if rows.is_empty() || d == 0 {
+        return DMatrix::zeros(problem.dim(), 0);
+    }
+    let projected = &problem.nullspace * &basis;
+    let nc = DMatrix::from_fn(rows.len(), d, |i, k| projected[(rows[i], k)]);
+    // Scale rows so that mass and m·r compare: divide by the bound scale.
+    let scaled = DMatrix::from_fn(rows.len(), d, |i, k| {
+        let scale = problem
+            .counterweights
+            .iter()
+            .find(|c| (c.column..c.column + 1 + c.axes.len()).contains(&rows[i]))
+            .map(|c| {
+                if rows[i] == c.column {
+                    c.bounds.mass[1].max(1e-9)
+                } else {
+                    (c.bounds.mass[1] * c.bounds.radius[1]).max(1e-9)
+                }
+            })
+            .unwrap_or(1.0);
+        nc[(i, k)] / scale
+    });
+    let svd = scaled.svd(false, true);
+    let v_t = svd.v_t.expect("V computed");
+    let smax = svd.singular_values.iter().fold(0.0f64, |a, &b| a.max(b));
+    let mut cols = Vec::new();
+    for (k, &s) in svd.singular_values.iter().enumerate() {
+        if s > 1e-9 * smax && smax > 0.0 {
+            // unit change in bound-scaled units per unit y
+            cols.push(&basis * (v_t.row(k).transpose() / s));
+        }
+    }
+    if cols.is_empty() {
+        DMatrix::zeros(problem.dim(), 0)
+    } else {
+        DMatrix::from_columns(&cols)
+    }
+}
+
+/// Objective plus penalty at `z`, with feasibility.
+pub fn merit(
+    problem: &VariantProblem,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    z: &DVector<f64>,
+    scale: f64,
+) -> (f64, f64, f64) {
+    let x = problem.lifted(z);
+    let cws = problem.cw_physical(&x);
+    if cws.iter().any(|c| c.mass.is_nan() || c.mass <= 0.0) {
+        return (f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    }
+    let e = problem.evaluate(&cws, tasks);
+    let value = e.objective(objective, problem.actuators);
+    let mut violation = problem.peak_excess(&e);
+    let mut penalty = violation.max(0.0);
+    for v in problem.bound_violations(&x) {
+        violation = violation.max(v);
+        penalty += v.max(0.0);
+    }
+    (value + 100.0 * scale * penalty, value, violation)
+}
+
+/// Nelder–Mead from `z0` along `directions`.
+pub fn refine(
+    problem: &VariantProblem,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    z0: &DVector<f64>,
+    directions: &DMatrix<f64>,
+    scale: f64,
+) -> Refined {
+    let n = directions.ncols();
+    let at = |y: &DVector<f64>| z0 + directions * y;
+    let (_, v0, viol0) = merit(problem, tasks, objective, z0, scale);
+    let mut best_feasible: Option<(DVector<f64>, f64, f64)> =
+        (viol0 <= 0.0).then(|| (z0.clone(), v0, viol0));
+    let mut best_any = (z0.clone(), v0, viol0);
+    let mut evaluations = 1;
+    if n == 0 {
+        return finish(best_feasible, best_any, evaluations);
+    }
+    let mut f = |y: &DVector<f64>, evals: &mut usize| {
+        *evals += 1;
+        let z = at(y);
+        let (m, v, viol) = merit(problem, tasks, objective, &z, scale);
+        if viol <= 0.0 && best_feasible.as_ref().is_none_or(|b| v < b.1) {
+            best_feasible = Some((z.clone(), v, viol));
+        }
+        if viol < best_any.2 || (viol <= 0.0 && v < best_any.1) {
+            best_any = (z, v, viol);
+        }
+        m
+    };
+    let mut center = DVector::zeros(n);
+    let mut step = 0.05;
+    for _restart in 0..6 {
+        let (y, improved) = nelder_mead(&mut f, &center, step, &mut evaluations);
+        center = y;
+        step *= 0.2;
+        if !improved && step < 1e-9 {
+            break;
+        }
+    }
+    finish(best_feasible, best_any, evaluations)
+}
+
+fn finish(
+    best_feasible: Option<(DVector<f64>, f64, f64)>,
+    best_any: (DVector<f64>, f64, f64),
+    evaluations: usize,
+) -> Refined {
+    match best_feasible {
+        Some((z, value, violation)) => Refined {
+            z,
+            value,
+            feasible: true,
+            violation,
+            evaluations,
+        },
+        None => Refined {
+            z: best_any.0,
+            value: best_any.1,
+            feasible: false,
+            violation: best_any.2,
+            evaluations,
+        },
+    }
+}
+
+/// Standard Nelder–Mead (reflection 1, expansion 2, contraction ½, shrink ½); returns the best
+/// vertex and whether it improved on the start.
+fn nelder_mead(
+    f: &mut impl FnMut(&DVector<f64>, &mut usize) -> f64,
+    start: &DVector<f64>,
+    step: f64,
+    evals: &mut usize,
+) -> (DVector<f64>, bool) {
+    let n = start.len();
+    let mut simplex: Vec<(DVector<f64>, f64)> = Vec::with_capacity(n + 1);
+    let f0 = f(start, evals);
+    simplex.push((start.clone(), f0));
+    for i in 0..n {
+        let mut p = start.clone();
+        p[i] += step;
+        let v = f(&p, evals);
+        simplex.push((p, v));
+    }
+    for _ in 0..400 * (n + 1) {
+        simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let (lo, hi) = (simplex[0].1, simplex[n].1);
+        let size = simplex
+            .iter()
+            .skip(1)
+            .map(|p| (&p.0 - &simplex[0].0).amax())
+            .fold(0.0, f64::max);
+        if size < 1e-11 || (hi - lo).abs() <= 1e-14 * lo.abs().max(1e-300) && size < 1e-7 {
+            break;
+        }
+        let centroid = simplex[..n]
+            .iter()
+            .fold(DVector::zeros(n), |acc, p| acc + &p.0)
+            / n as f64;
+        let worst = simplex[n].0.clone();
+        let reflect = &centroid + (&centroid - &worst);
+        let fr = f(&reflect, evals);
+        if fr < simplex[0].1 {
+            let expand = &centroid + (&centroid - &worst) * 2.0;
+            let fe = f(&expand, evals);
+            simplex[n] = if fe < fr { (expand, fe) } else { (reflect, fr) };
+        } else if fr < simplex[n - 1].1 {
+            simplex[n] = (reflect, fr);
+        } else {
+            let contract = if fr < simplex[n].1 {
+                &centroid + (&reflect - &centroid) * 0.5
+            } else {
+                &centroid + (&worst - &centroid) * 0.5
+            };
+            let fc = f(&contract, evals);
+            if fc < simplex[n].1.min(fr) {
+                simplex[n] = (contract, fc);
+            } else {
+                let best = simplex[0].0.clone();
+                for p in simplex.iter_mut().skip(1) {
+                    p.0 = &best + (&p.0 - &best) * 0.5;
+                    p.1 = f(&p.0, evals);
+                }
+            }
+        }
+    }
+    simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
+    (simplex[0].0.clone(), simplex[0].1 < f0)
+}

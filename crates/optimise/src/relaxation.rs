@@ -1,0 +1,361 @@
+//! The convex relaxation (a certified lower bound), solved with clarabel.
+//!
+//! Variables: the free coordinates `z` of the balanced family, and per counterweight the
+//! second moment `S` (entries over its plane axes) and `p`, standing for `m^{5/3}`. The torque
+//! at every working-set sample is affine in `(m, μ, S, p)`:
+//! `I_o = p·J(1 kg) + tr(S)·I − S`. The non-convex identities are relaxed:
+//!
+//! - `S = μμᵀ/m` → `S_aa·m ≥ μ_a²` per axis, `tr(S)·m ≥ |μ|²`, `dᵀSd·m ≥ (dᵀμ)²` along the
+//!   diagonals `d = (e_a ± e_b)/√2`, `S` positive semidefinite per 2×2 block (all rotated or
+//!   plain second-order cones), and the linear `r_lo²·m ≤ tr(S) ≤ r_hi²·m` (true because
+//!   `tr S = m|r|²`);
+//! - `p = m^{5/3}` → `p^{3/5} ≥ m` (power cone) and `p` below the chord of `m^{5/3}` over the
+//!   mass range;
+//! - `|r| ≥ r_lo`, `|a| ≥ a_lo`, `|b| ≥ b_lo` and spring realizability (`K·W = αβᵀ`) are dropped.
+//!
+//! The bounds that are convex in the lifted variables are kept exactly: masses, `|μ| ≤ r_hi·m`,
+//! stiffnesses, `|K a| ≤ a_hi·K`, `|K b| ≤ b_hi·K`; the peak limits are linear inequalities at
+//! every working-set sample. The objective is RMS* (`min ‖t‖/√N`, `t_n ≥` the RMS of actuator
+//! `n` on each working-set task) or, for minimax, `min u`, `u ≥ Σ_n RMS_{n,w}` per task.
+//!
+//! Every physical point is feasible here with the same objective, so the optimum is a lower
+//! bound of the working-set problem; since the working-set objective never exceeds the
+//! all-task one, it bounds the true optimum too.
+
+use std::sync::Arc;
+
+use counterpoise_dynamics::params::BODY_PARAMS;
+use nalgebra::DVector;
+
+use crate::clarabel_map::{Affine, ConicProblem, ConicSolution};
+use crate::problem::{Objective, VariantProblem};
+use crate::torque::TaskTorques;
+
+/// Result of the relaxation.
+#[derive(Clone, Debug)]
+pub struct Relaxed {
+    pub solution: ConicSolution,
+    /// Free coordinates of the relaxed optimum.
+    pub z: DVector<f64>,
+    /// The lower bound: the smaller of the primal and dual objective values (the dual value is
+    /// the certificate; clarabel's primal value may exceed the optimum by its tolerance).
+    pub bound: f64,
+}
+
+/// Index of the `S` entry `(a, b)`, `a ≤ b`, among a counterweight's axes pairs.
+fn pairs(n: usize) -> Vec<(usize, usize)> {
+    let mut v = Vec::new();
+    for a in 0..n {
+        for b in a..n {
+            v.push((a, b));
+        }
+    }
+    v
+}
+
+/// The index into `π` of `I_ab` for body axes `a ≤ b`.
+fn inertia_index(a: usize, b: usize) -> usize {
+    match (a, b) {
+        (0, 0) => 4,
+        (1, 1) => 5,
+        (2, 2) => 6,
+        (0, 1) => 7,
+        (0, 2) => 8,
+        (1, 2) => 9,
+        _ => unreachable!(),
+    }
+}
+
+/// Natural magnitude of each lifted variable (mass bound, `m·r` bound, stiffness bound, …), used
+/// to scale rows and the free coordinates so that every quantity clarabel sees is O(1).
+fn natural_scales(problem: &VariantProblem) -> Vec<f64> {
+    let mut scale = vec![1.0; problem.particular.len()];
+    for c in &problem.counterweights {
+        let m = c.bounds.mass[1].max(1e-9);
+        scale[c.column] = m;
+        for k in 0..c.axes.len() {
+            scale[c.column + 1 + k] = (m * c.bounds.radius[1]).max(1e-9 * m);
+        }
+    }
+    for s in &problem.springs {
+        let k = s.bounds.stiffness[1].max(1e-9);
+        let (na, nb) = (s.axes_a.len(), s.axes_b.len());
+        let a = s.bounds.anchor_a[1].max(1e-3);
+        let b = s.bounds.anchor_b[1].max(1e-3);
+        scale[s.column] = k;
+        for i in 0..na {
+            scale[s.column + 1 + i] = k * a;
+        }
+        for l in 0..nb {
+            scale[s.column + 1 + na + l] = k * b;
+        }
+        for i in 0..na * nb {
+            scale[s.column + 1 + na + nb + i] = k * a * b;
+        }
+    }
+    scale
+}
+
+/// Builds and solves the relaxation on the working-set tasks.
+pub fn solve_relaxation(
+    problem: &VariantProblem,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    max_iter: u32,
+) -> Relaxed {
+    let mut cp = ConicProblem::default();
+    let d = problem.dim();
+    let natural = natural_scales(problem);
+    // z = D ζ with D chosen so that a unit ζ_k moves no lifted variable by more than its
+    // natural magnitude.
+    let dz: Vec<f64> = (0..d)
+        .map(|k| {
+            let worst = (0..natural.len())
+                .map(|j| (problem.nullspace[(j, k)] / natural[j]).abs())
+                .fold(0.0f64, f64::max);
+            if worst > 0.0 { 1.0 / worst } else { 1.0 }
+        })
+        .collect();
+    let z: Vec<usize> = (0..d).map(|_| cp.new_variable()).collect();
+    // x_j / natural_j as an affine expression of ζ.
+    let xn = |j: usize| {
+        let mut e = Affine::constant(problem.particular[j] / natural[j]);
+        for k in 0..d {
+            let c = problem.nullspace[(j, k)] * dz[k] / natural[j];
+            if c != 0.0 {
+                e.add_var(z[k], c);
+            }
+        }
+        e
+    };
+
+    // Per counterweight: feature expressions (true units) and their torque columns.
+    struct Feature {
+        expr: Affine,
+        /// (slot, π index, coefficient) — torque per unit feature = Σ coef·sens(slot, idx).
+        parts: Vec<(usize, usize, f64)>,
+    }
+    let mut features: Vec<Feature> = Vec::new();
+    for c in &problem.counterweights {
+        let big_m = natural[c.column];
+        let mn = xn(c.column);
+        let n_ax = c.axes.len();
+        let mun: Vec<Affine> = (0..n_ax).map(|k| xn(c.column + 1 + k)).collect();
+        let big_r = if n_ax > 0 { natural[c.column + 1] } else { 1.0 };
+        let [rlo, rhi] = c.bounds.radius;
+        let sigma = (big_m * rhi * rhi).max(1e-12 * big_m);
+        features.push(Feature {
+            expr: mn.scaled(big_m),
+            parts: vec![(c.torque_slot, 0, 1.0)],
+        });
+        for (k, &a) in c.axes.iter().enumerate() {
+            features.push(Feature {
+                expr: mun[k].scaled(big_r),
+                parts: vec![(c.torque_slot, 1 + a, 1.0)],
+            });
+        }
+        // Normalised second moments s' = S/σ over the plane axes.
+        let ps = pairs(n_ax);
+        let s_vars: Vec<usize> = ps.iter().map(|_| cp.new_variable()).collect();
+        let s_of = |a: usize, b: usize| {
+            let (a, b) = if a <= b { (a, b) } else { (b, a) };
+            s_vars[ps.iter().position(|&p| p == (a, b)).expect("pair")]
+        };
+        for (idx, &(ka, kb)) in ps.iter().enumerate() {
+            let (a, b) = (c.axes[ka], c.axes[kb]);
+            let mut parts = Vec::new();
+            if a == b {
+                // S_aa adds to I_bb for every b ≠ a.
+                for other in 0..3 {
+                    if other != a {
+                        parts.push((c.torque_slot, inertia_index(other, other), 1.0));
+                    }
+                }
+            } else {
+                parts.push((c.torque_slot, inertia_index(a.min(b), a.max(b)), -1.0));
+            }
+            features.push(Feature {
+                expr: Affine::var(s_vars[idx]).scaled(sigma),
+                parts,
+            });
+        }
+        // S·m ≥ μμᵀ (relaxed), in normalised units: s'·m' ≥ μ'² (σ·M = R²).
+        let ratio = sigma * big_m / (big_r * big_r);
+        let half_m = mn.scaled(0.5 * ratio);
+        let mut trace = Affine::default();
+        for ka in 0..n_ax {
+            trace.add_var(s_of(ka, ka), 1.0);
+            cp.rotated_soc(&Affine::var(s_of(ka, ka)), &half_m, &[mun[ka].clone()]);
+        }
+        cp.rotated_soc(&trace, &half_m, &mun);
+        for ka in 0..n_ax {
+            for kb in ka + 1..n_ax {
+                let mut sum = Affine::var(s_of(ka, ka));
+                sum.add_var(s_of(kb, kb), 1.0);
+                let mut diff = Affine::var(s_of(ka, ka));
+                diff.add_var(s_of(kb, kb), -1.0);
+                cp.soc(&sum, &[diff, Affine::var(s_of(ka, kb)).scaled(2.0)]);
+                for sign in [1.0, -1.0] {
+                    let mut dsd = sum.scaled(0.5);
+                    dsd.add_var(s_of(ka, kb), sign);
+                    let mut dmu = mun[ka].scaled(std::f64::consts::FRAC_1_SQRT_2);
+                    dmu.add_scaled(&mun[kb], sign * std::f64::consts::FRAC_1_SQRT_2);
+                    cp.rotated_soc(&dsd, &half_m, &[dmu]);
+                }
+            }
+        }
+        // r_lo²·m ≤ tr S ≤ r_hi²·m.
+        let mut upper = mn.scaled(rhi * rhi * big_m / sigma);
+        upper.add_scaled(&trace, -1.0);
+        cp.nonneg(&upper);
+        let mut lower = trace.clone();
+        lower.add_scaled(&mn, -rlo * rlo * big_m / sigma);
+        cp.nonneg(&lower);
+        // Mass bounds and |μ| ≤ r_hi m.
+        let (mlo, mhi) = (c.min_mass(), c.bounds.mass[1]);
+        let mut e = mn.clone();
+        e.constant -= mlo / big_m;
+        cp.nonneg(&e);
+        let mut e = mn.scaled(-1.0);
+        e.constant += mhi / big_m;
+        cp.nonneg(&e);
+        cp.soc(&mn.scaled(rhi * big_m / big_r), &mun);
+        // Cylinder inertia: p = P·p', P = M^{5/3}; p'^{3/5} ≥ m/M and p below the chord.
+        let j_norm = c.j1.abs().max();
+        if j_norm > 0.0 {
+            let big_p = big_m.powf(5.0 / 3.0);
+            let p = cp.new_variable();
+            cp.power(&Affine::var(p), &Affine::constant(1.0), &mn, 0.6);
+            if mhi > mlo {
+                let (plo, phi) = (mlo.powf(5.0 / 3.0), mhi.powf(5.0 / 3.0));
+                let slope = (phi - plo) / (mhi - mlo);
+                let mut chord = mn.scaled(slope * big_m / big_p);
+                chord.constant += (plo - slope * mlo) / big_p;
+                chord.add_var(p, -1.0);
+                cp.nonneg(&chord);
+            }
+            let mut parts = Vec::new();
+            for a in 0..3 {
+                for b in a..3 {
+                    let v = c.j1[(a, b)];
+                    if v != 0.0 {
+                        parts.push((c.torque_slot, inertia_index(a, b), v));
+                    }
+                }
+            }
+            features.push(Feature {
+                expr: Affine::var(p).scaled(big_p),
+                parts,
+            });
+        }
+    }
+    // Spring bounds (the convex ones), normalised.
+    for s in &problem.springs {
+        let k = xn(s.column);
+        let na = s.axes_a.len();
+        let nb = s.axes_b.len();
+        let alpha: Vec<Affine> = (0..na).map(|i| xn(s.column + 1 + i)).collect();
+        let beta: Vec<Affine> = (0..nb).map(|i| xn(s.column + 1 + na + i)).collect();
+        let big_k = natural[s.column];
+        let [klo, khi] = s.bounds.stiffness;
+        let mut e = k.clone();
+        e.constant -= klo.max(0.0) / big_k;
+        cp.nonneg(&e);
+        let mut e = k.scaled(-1.0);
+        e.constant += khi / big_k;
+        cp.nonneg(&e);
+        if na > 0 {
+            let a_scale = natural[s.column + 1] / big_k;
+            cp.soc(&k.scaled(s.bounds.anchor_a[1] / a_scale), &alpha);
+        }
+        if nb > 0 {
+            let b_scale = natural[s.column + 1 + na] / big_k;
+            cp.soc(&k.scaled(s.bounds.anchor_b[1] / b_scale), &beta);
+        }
+    }
+
+    // Torque expressions per task, sample, actuator, divided by a torque scale.
+    let na = problem.actuators;
+    let tau_scale = tasks
+        .iter()
+        .flat_map(|t| t.base.iter())
+        .fold(0.0f64, |a, &b| a.max(b.abs()))
+        .max(1e-9);
+    let torque = |t: &TaskTorques, s: usize, a: usize| {
+        let mut e = Affine::constant(t.base[s * na + a]);
+        for f in &features {
+            let coef: f64 = f
+                .parts
+                .iter()
+                .map(|&(slot, j, c)| c * t.sens(slot, j)[s * na + a])
+                .sum();
+            if coef != 0.0 {
+                e.add_scaled(&f.expr, coef);
+            }
+        }
+        e
+    };
+    const { assert!(BODY_PARAMS == 10) };
+
+    let u = cp.new_variable();
+    cp.objective[u] = 1.0;
+    match objective {
+        Objective::RmsStar => {
+            let t: Vec<usize> = (0..na).map(|_| cp.new_variable()).collect();
+            let scale = 1.0 / (na.max(1) as f64).sqrt();
+            cp.soc(
+                &Affine::var(u),
+                &t.iter()
+                    .map(|&v| Affine::var(v).scaled(scale))
+                    .collect::<Vec<_>>(),
+            );
+            for task in tasks {
+                let w = 1.0 / ((task.samples as f64).sqrt() * tau_scale);
+                for a in 0..na {
+                    let tail: Vec<Affine> = (0..task.samples)
+                        .map(|s| torque(task, s, a).scaled(w))
+                        .collect();
+                    cp.soc(&Affine::var(t[a]), &tail);
+                }
+            }
+        }
+        Objective::Minimax => {
+            for task in tasks {
+                let w = 1.0 / ((task.samples as f64).sqrt() * tau_scale);
+                let t: Vec<usize> = (0..na).map(|_| cp.new_variable()).collect();
+                let mut sum = Affine::var(u);
+                for a in 0..na {
+                    sum.add_var(t[a], -1.0);
+                    let tail: Vec<Affine> = (0..task.samples)
+                        .map(|s| torque(task, s, a).scaled(w))
+                        .collect();
+                    cp.soc(&Affine::var(t[a]), &tail);
+                }
+                cp.nonneg(&sum);
+            }
+        }
+    }
+    // Peak limits, relative to each limit.
+    for task in tasks {
+        for (a, lim) in problem.peak_limits.iter().enumerate() {
+            if let Some(lim) = *lim {
+                for s in 0..task.samples {
+                    let e = torque(task, s, a).scaled(1.0 / lim);
+                    let mut up = e.scaled(-1.0);
+                    up.constant += 1.0;
+                    cp.nonneg(&up);
+                    let mut down = e;
+                    down.constant += 1.0;
+                    cp.nonneg(&down);
+                }
+            }
+        }
+    }
+    let solution = cp.solve(max_iter);
+    let zv = DVector::from_iterator(d, z.iter().zip(&dz).map(|(&j, &s)| solution.x[j] * s));
+    Relaxed {
+        bound: tau_scale * solution.objective.min(solution.dual_objective),
+        z: zv,
+        solution,
+    }
+}

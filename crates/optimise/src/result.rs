@@ -1,0 +1,198 @@
+//! Serialisable results of the optimisation stage (SI units in the data; [`display_rows`]
+//! gives the paper's Table 1 units: N/mm, mm, kg, rad).
+
+use counterpoise_balance::{Attachment, Class};
+use counterpoise_dynamics::Indicators;
+use serde::Serialize;
+
+use crate::clarabel_map::ConicStatus;
+use crate::problem::Objective;
+use crate::verify::VerificationReport;
+
+/// `feasible` or `discarded` (paper Proc-6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OptimisedStatus {
+    Feasible,
+    Discarded,
+}
+
+/// An optimised counterweight (SI).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OptimisedCounterweight {
+    pub label: String,
+    pub body: String,
+    /// kg.
+    pub mass: f64,
+    /// CoM in the body frame, m.
+    pub offset: [f64; 3],
+    /// |r|, m.
+    pub radius: f64,
+}
+
+/// An optimised spring (SI).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OptimisedSpring {
+    pub label: String,
+    pub body: String,
+    pub other: String,
+    #[serde(skip)]
+    pub other_attachment: Option<Attachment>,
+    /// N/m.
+    pub stiffness: f64,
+    /// m, frame of `body`.
+    pub anchor_a: [f64; 3],
+    /// m, frame of `other`.
+    pub anchor_b: [f64; 3],
+}
+
+/// One free coordinate of the balanced family at the chosen point: the lifted parameters are
+/// `x_p + Σ_k value_k · direction_k` (directions normalised like the balance crate's, largest
+/// component ±1). `interval` is the range of this coordinate, the others held, over which the
+/// bounds that are convex in the lifted parameters hold (masses, `|r| ≤ r_hi`, stiffness,
+/// `|a| ≤ a_hi`, `|b| ≤ b_hi`); the lower radius/anchor bounds and spring realizability are
+/// checked at the chosen point only.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FreeParameter {
+    pub components: Vec<(String, f64)>,
+    pub value: f64,
+    pub interval: [f64; 2],
+    /// Whether this coordinate changes a counterweight (otherwise only springs: motor torques
+    /// do not depend on it).
+    pub moves_counterweights: bool,
+}
+
+/// One pass of the critical-task loop (Proc-7/8).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Iteration {
+    /// Tasks `[from, to]` the pass optimised over.
+    pub tasks: usize,
+    /// Lower bound from the relaxation on those tasks (N·m).
+    pub lower_bound: f64,
+    /// Objective on those tasks at the pass's optimum (N·m).
+    pub objective_working: f64,
+    /// Objective over all tasks at the pass's optimum (N·m).
+    pub objective_all: f64,
+    /// Newly critical tasks found over all tasks (added for the next pass).
+    pub added: Vec<[usize; 2]>,
+    pub relaxation_status: ConicStatus,
+    pub relaxation_iterations: u32,
+    /// Relative gap between the relaxation and the true value at its recovered point, before
+    /// local refinement.
+    pub gap_before_refinement: f64,
+}
+
+/// The optimisation result of one balanced variant.
+#[derive(Clone, Debug, Serialize)]
+pub struct OptimisedVariant {
+    /// Element labels (`m4`, `K43`).
+    pub elements: Vec<String>,
+    pub class: Class,
+    pub status: OptimisedStatus,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    pub objective_kind: Objective,
+    /// True objective over all tasks (RMS* or QTR), N·m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub objective: Option<f64>,
+    /// Certified lower bound on the optimum (N·m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lower_bound: Option<f64>,
+    /// `(objective − lower_bound)/objective`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gap: Option<f64>,
+    /// Balance residual of the final parameters (the verification's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual: Option<f64>,
+    pub converged: bool,
+    pub iterations: Vec<Iteration>,
+    /// The final working set of critical tasks.
+    pub critical_tasks: Vec<[usize; 2]>,
+    pub counterweights: Vec<OptimisedCounterweight>,
+    pub springs: Vec<OptimisedSpring>,
+    pub free_parameters: Vec<FreeParameter>,
+    /// ΔR (%) on the reaction tasks used to choose the springs (UB joint-critical tasks and the
+    /// critical tasks).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delta_r_estimate: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verification: Option<VerificationReport>,
+    /// Indicators over all tasks of the final parameters (with reactions when requested).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub indicators: Option<Indicators>,
+}
+
+impl OptimisedVariant {
+    pub fn is_feasible(&self) -> bool {
+        self.status == OptimisedStatus::Feasible
+    }
+}
+
+/// One row of the paper's Table 1 (N/mm, mm, rad, kg).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DisplayRow {
+    pub label: String,
+    pub stiffness_n_per_mm: Option<f64>,
+    pub a_mm: Option<f64>,
+    pub alpha_rad: Option<f64>,
+    pub b_mm: Option<f64>,
+    pub beta_rad: Option<f64>,
+    pub mass_kg: Option<f64>,
+    pub r_mm: Option<f64>,
+    pub phi_rad: Option<f64>,
+}
+
+/// Planar angle in `[0, 2π)` of a body-frame vector in the plane of its two largest axes
+/// (x–y unless the vector lies elsewhere).
+fn angle(v: [f64; 3]) -> f64 {
+    let (x, y) = if v[2].abs() > 0.0 && v[0] == 0.0 {
+        (v[1], v[2])
+    } else if v[2].abs() > 0.0 && v[1] == 0.0 {
+        (v[0], v[2])
+    } else {
+        (v[0], v[1])
+    };
+    let a = y.atan2(x);
+    if a < -1e-12 {
+        a + std::f64::consts::TAU
+    } else {
+        a.max(0.0)
+    }
+}
+
+fn len(v: [f64; 3]) -> f64 {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+/// Table rows of a variant in the paper's units.
+pub fn display_rows(v: &OptimisedVariant) -> Vec<DisplayRow> {
+    let mut rows = Vec::new();
+    for label in &v.elements {
+        if let Some(c) = v.counterweights.iter().find(|c| &c.label == label) {
+            rows.push(DisplayRow {
+                label: label.clone(),
+                stiffness_n_per_mm: None,
+                a_mm: None,
+                alpha_rad: None,
+                b_mm: None,
+                beta_rad: None,
+                mass_kg: Some(c.mass),
+                r_mm: Some(c.radius * 1e3),
+                phi_rad: Some(angle(c.offset)),
+            });
+        } else if let Some(s) = v.springs.iter().find(|s| &s.label == label) {
+            rows.push(DisplayRow {
+                label: label.clone(),
+                stiffness_n_per_mm: Some(s.stiffness * 1e-3),
+                a_mm: Some(len(s.anchor_a) * 1e3),
+                alpha_rad: Some(angle(s.anchor_a)),
+                b_mm: Some(len(s.anchor_b) * 1e3),
+                beta_rad: Some(angle(s.anchor_b)),
+                mass_kg: None,
+                r_mm: None,
+                phi_rad: None,
+            });
+        }
+    }
+    rows
+}

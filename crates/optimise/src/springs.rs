@@ -1,0 +1,461 @@
+//! Springs: physical parameters inside the balanced family, within bounds, chosen for low joint
+//! reactions.
+//!
+//! With the counterweights fixed, the springs must supply the rest of the balance:
+//! `A_S ℓ(y) = −(b + A_C x_C)`, where `ℓ(y) = (K, K a, K b, K a⊗b)` is the lifted vector of the
+//! physical spring parameters `y = (ln K, a, b)` — realizable by construction. Like the balance
+//! crate's realization this is a small nonlinear least-squares problem, solved by
+//! Levenberg–Marquardt, here with hinge rows for the bounds (`K`, `|a|`, `|b|`, lower bounds
+//! included) so that every accepted solution is inside them. Deterministic starts (the lifted
+//! optimum first, then pseudo-random points inside the bounds) give several admissible spring
+//! sets; since massless springs never change a balanced variant's motor torques, the one with
+//! the lowest joint-reaction indicator ΔR (paper Eqs. 17–21) on the reaction tasks is kept.
+
+use counterpoise_balance::Attachment;
+use counterpoise_model::sampling::SplitMix64;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use crate::problem::{VariantProblem, norm};
+
+/// Physical parameters of one spring.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SpringValues {
+    pub entry: usize,
+    pub label: String,
+    pub body: usize,
+    pub other: Attachment,
+    /// N/m.
+    pub stiffness: f64,
+    /// m, body frame of `body`.
+    pub anchor_a: [f64; 3],
+    /// m, frame of `other`.
+    pub anchor_b: [f64; 3],
+}
+
+/// Relative balance residual accepted from the local solve (the energy sampling is the real
+/// check).
+const SOLVED_TOL: f64 = 1e-13;
+/// Bound excess accepted from the local solve (relative).
+const BOUND_TOL: f64 = 1e-12;
+
+struct Layout {
+    /// First unknown of each spring in `y`.
+    start: Vec<usize>,
+    /// First unknown of each counterweight (joint mode only): `m/M`, `μ/(M r_hi)`.
+    cw_start: Vec<usize>,
+    unknowns: usize,
+}
+
+/// `(M, R)`: the normalising mass and first-moment scales of a counterweight.
+fn cw_scales(c: &crate::problem::CwSlot) -> (f64, f64) {
+    let m = c.bounds.mass[1].max(1e-9);
+    (m, (m * c.bounds.radius[1]).max(1e-9 * m))
+}
+
+fn layout(problem: &VariantProblem, joint: bool) -> Layout {
+    let mut start = Vec::new();
+    let mut cw_start = Vec::new();
+    let mut n = 0;
+    for s in &problem.springs {
+        start.push(n);
+        n += 1 + s.axes_a.len() + s.axes_b.len();
+    }
+    if joint {
+        for c in &problem.counterweights {
+            cw_start.push(n);
+            n += 1 + c.axes.len();
+        }
+    }
+    Layout {
+        start,
+        cw_start,
+        unknowns: n,
+    }
+}
+
+/// The lifted vector with the springs replaced by `y`.
+fn lifted_with(
+    problem: &VariantProblem,
+    x: &DVector<f64>,
+    lay: &Layout,
+    y: &DVector<f64>,
+) -> DVector<f64> {
+    let mut out = x.clone();
+    for (k, s) in problem.springs.iter().enumerate() {
+        let u = lay.start[k];
+        let (na, nb) = (s.axes_a.len(), s.axes_b.len());
+        let kk = y[u].exp();
+        out[s.column] = kk;
+        for i in 0..na {
+            out[s.column + 1 + i] = kk * y[u + 1 + i];
+        }
+        for l in 0..nb {
+            out[s.column + 1 + na + l] = kk * y[u + 1 + na + l];
+        }
+        for i in 0..na {
+            for l in 0..nb {
+                out[s.column + 1 + na + nb + i * nb + l] = kk * y[u + 1 + i] * y[u + 1 + na + l];
+            }
+        }
+    }
+    for (c, &u) in problem.counterweights.iter().zip(&lay.cw_start) {
+        let (big_m, big_r) = cw_scales(c);
+        out[c.column] = y[u] * big_m;
+        for k in 0..c.axes.len() {
+            out[c.column + 1 + k] = y[u + 1 + k] * big_r;
+        }
+    }
+    out
+}
+
+/// Residual rows and Jacobian: balance (relative to ‖b‖), bound hinges, optional pull.
+fn residual(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    x: &DVector<f64>,
+    lay: &Layout,
+    y: &DVector<f64>,
+    pull: Option<(&DVector<f64>, f64)>,
+) -> (DVector<f64>, DMatrix<f64>, f64, f64) {
+    let a = &problem.solution.matrix;
+    let scale = 1.0 / b.norm().max(f64::MIN_POSITIVE);
+    let xl = lifted_with(problem, x, lay, y);
+    let rows = a.nrows();
+    let balance = (a * &xl + b) * scale;
+    let mut r_rows: Vec<f64> = balance.iter().copied().collect();
+    let mut jac_rows: Vec<Vec<f64>> = vec![vec![0.0; lay.unknowns]; rows];
+    let mut hinge_max = 0.0f64;
+    for (k, s) in problem.springs.iter().enumerate() {
+        let u = lay.start[k];
+        let (na, nb) = (s.axes_a.len(), s.axes_b.len());
+        let kk = y[u].exp();
+        let av: Vec<f64> = (0..na).map(|i| y[u + 1 + i]).collect();
+        let bv: Vec<f64> = (0..nb).map(|l| y[u + 1 + na + l]).collect();
+        let col = |j: usize| a.column(s.column + j);
+        // d/d ln K: the spring's own lifted vector
+        let own = s.column..s.column + s.lifted_len();
+        for row in 0..rows {
+            let mut dk = 0.0;
+            for j in own.clone() {
+                dk += a[(row, j)] * xl[j];
+            }
+            jac_rows[row][u] = dk * scale;
+        }
+        for i in 0..na {
+            let mut d = col(1 + i) * kk;
+            for l in 0..nb {
+                d += col(1 + na + nb + i * nb + l) * (kk * bv[l]);
+            }
+            for row in 0..rows {
+                jac_rows[row][u + 1 + i] = d[row] * scale;
+            }
+        }
+        for l in 0..nb {
+            let mut d = col(1 + na + l) * kk;
+            for i in 0..na {
+                d += col(1 + na + nb + i * nb + l) * (kk * av[i]);
+            }
+            for row in 0..rows {
+                jac_rows[row][u + 1 + na + l] = d[row] * scale;
+            }
+        }
+        // Bound hinges.
+        let [klo, khi] = s.bounds.stiffness;
+        let mut hinge = |value: f64, grad: Vec<(usize, f64)>| {
+            hinge_max = hinge_max.max(value);
+            let mut row = vec![0.0; lay.unknowns];
+            if value > 0.0 {
+                for (j, g) in grad {
+                    row[j] = g;
+                }
+            }
+            r_rows.push(value.max(0.0));
+            jac_rows.push(row);
+        };
+        if klo > 0.0 {
+            hinge(klo.ln() - y[u], vec![(u, -1.0)]);
+        }
+        hinge(y[u] - khi.ln(), vec![(u, 1.0)]);
+        for (range, offset, n) in [(s.bounds.anchor_a, 1, na), (s.bounds.anchor_b, 1 + na, nb)] {
+            let v: Vec<f64> = (0..n).map(|i| y[u + offset + i]).collect();
+            let len = norm(&v);
+            let l = range[1].max(1e-3);
+            let unit: Vec<f64> = v
+                .iter()
+                .map(|c| if len > 0.0 { c / len } else { 0.0 })
+                .collect();
+            hinge(
+                (range[0] - len) / l,
+                (0..n).map(|i| (u + offset + i, -unit[i] / l)).collect(),
+            );
+            hinge(
+                (len - range[1]) / l,
+                (0..n).map(|i| (u + offset + i, unit[i] / l)).collect(),
+            );
+        }
+    }
+    for (c, &u) in problem.counterweights.iter().zip(&lay.cw_start) {
+        let (big_m, big_r) = cw_scales(c);
+        for row in 0..rows {
+            jac_rows[row][u] = a[(row, c.column)] * big_m * scale;
+            for k in 0..c.axes.len() {
+                jac_rows[row][u + 1 + k] = a[(row, c.column + 1 + k)] * big_r * scale;
+            }
+        }
+        let n = c.axes.len();
+        let mu: Vec<f64> = (0..n).map(|k| y[u + 1 + k]).collect();
+        let len = norm(&mu);
+        let unit: Vec<f64> = mu
+            .iter()
+            .map(|v| if len > 0.0 { v / len } else { 0.0 })
+            .collect();
+        let rows_of = |value: f64,
+                       grad: Vec<(usize, f64)>,
+                       r: &mut Vec<f64>,
+                       j: &mut Vec<Vec<f64>>,
+                       h: &mut f64| {
+            *h = h.max(value);
+            let mut row = vec![0.0; lay.unknowns];
+            if value > 0.0 {
+                for (k, g) in grad {
+                    row[k] = g;
+                }
+            }
+            r.push(value.max(0.0));
+            j.push(row);
+        };
+        let [mlo, mhi] = [c.min_mass() / big_m, c.bounds.mass[1] / big_m];
+        rows_of(
+            mlo - y[u],
+            vec![(u, -1.0)],
+            &mut r_rows,
+            &mut jac_rows,
+            &mut hinge_max,
+        );
+        rows_of(
+            y[u] - mhi,
+            vec![(u, 1.0)],
+            &mut r_rows,
+            &mut jac_rows,
+            &mut hinge_max,
+        );
+        let hi = c.bounds.radius[1] * big_m / big_r;
+        let lo = c.bounds.radius[0] * big_m / big_r;
+        let mut grad: Vec<(usize, f64)> = (0..n).map(|k| (u + 1 + k, unit[k])).collect();
+        grad.push((u, -hi));
+        rows_of(
+            len - hi * y[u],
+            grad,
+            &mut r_rows,
+            &mut jac_rows,
+            &mut hinge_max,
+        );
+        let mut grad: Vec<(usize, f64)> = (0..n).map(|k| (u + 1 + k, -unit[k])).collect();
+        grad.push((u, lo));
+        rows_of(
+            lo * y[u] - len,
+            grad,
+            &mut r_rows,
+            &mut jac_rows,
+            &mut hinge_max,
+        );
+    }
+    let balance_norm = balance.norm();
+    if let Some((target, weight)) = pull {
+        for j in 0..lay.unknowns {
+            let mut row = vec![0.0; lay.unknowns];
+            row[j] = weight;
+            r_rows.push(weight * (y[j] - target[j]));
+            jac_rows.push(row);
+        }
+    }
+    let r = DVector::from_vec(r_rows);
+    let jac = DMatrix::from_fn(jac_rows.len(), lay.unknowns, |i, j| jac_rows[i][j]);
+    (r, jac, balance_norm, hinge_max)
+}
+
+fn levenberg_marquardt(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    x: &DVector<f64>,
+    lay: &Layout,
+    mut y: DVector<f64>,
+    pull: Option<(&DVector<f64>, f64)>,
+) -> (DVector<f64>, f64, f64) {
+    let (mut r, mut jac, mut bal, mut hinge) = residual(problem, b, x, lay, &y, pull);
+    let mut cost = r.norm();
+    let mut lambda = 1e-3;
+    for _ in 0..300 {
+        if pull.is_none() && bal <= SOLVED_TOL && hinge <= BOUND_TOL {
+            break;
+        }
+        let jtj = jac.transpose() * &jac;
+        let g = jac.transpose() * &r;
+        let mut improved = false;
+        for _ in 0..12 {
+            let mut damped = jtj.clone();
+            for i in 0..lay.unknowns {
+                damped[(i, i)] += lambda * (jtj[(i, i)] + 1e-12);
+            }
+            let Some(ch) = damped.cholesky() else {
+                lambda *= 10.0;
+                continue;
+            };
+            let step = ch.solve(&(-&g));
+            let mut cand = &y + &step;
+            for (k, s) in problem.springs.iter().enumerate() {
+                let _ = s;
+                let u = lay.start[k];
+                cand[u] = cand[u].clamp(-30.0, 30.0);
+            }
+            let (r2, j2, b2, h2) = residual(problem, b, x, lay, &cand, pull);
+            let c2 = r2.norm();
+            if c2.is_finite() && c2 < cost {
+                let gain = (cost - c2) / cost.max(f64::MIN_POSITIVE);
+                y = cand;
+                r = r2;
+                jac = j2;
+                bal = b2;
+                hinge = h2;
+                cost = c2;
+                lambda = (lambda / 3.0).max(1e-15);
+                improved = gain > 1e-15;
+                break;
+            }
+            lambda *= 4.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    (y, bal, hinge)
+}
+
+/// Physical springs at `y`.
+fn values(problem: &VariantProblem, lay: &Layout, y: &DVector<f64>) -> Vec<SpringValues> {
+    problem
+        .springs
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let u = lay.start[k];
+            let na = s.axes_a.len();
+            let mut anchor_a = [0.0; 3];
+            let mut anchor_b = [0.0; 3];
+            for (i, &ax) in s.axes_a.iter().enumerate() {
+                anchor_a[ax] = y[u + 1 + i];
+            }
+            for (l, &ax) in s.axes_b.iter().enumerate() {
+                anchor_b[ax] = y[u + 1 + na + l];
+            }
+            SpringValues {
+                entry: s.entry,
+                label: s.label.clone(),
+                body: s.body,
+                other: s.other,
+                stiffness: y[u].exp(),
+                anchor_a,
+                anchor_b,
+            }
+        })
+        .collect()
+}
+
+/// One admissible spring set and the full lifted point with it.
+pub type Realized = (Vec<SpringValues>, DVector<f64>);
+
+/// Admissible spring sets for the lifted point `x` (its counterweight part is kept), from
+/// `starts` deterministic starts; distinct solutions only, in order of discovery.
+///
+/// With `joint`, the counterweights move too (starting from, and pulled towards, their values
+/// in `x`): the fallback when the counterweights that are best for the motors leave no
+/// admissible springs.
+pub fn realize_springs(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    x: &DVector<f64>,
+    starts: usize,
+    joint: bool,
+) -> (Vec<Realized>, String) {
+    let lay = layout(problem, joint);
+    if lay.unknowns == 0 {
+        return (vec![(Vec::new(), x.clone())], String::new());
+    }
+    let mut rng = SplitMix64::new(0x5917_6e55_0000_0001);
+    let mut found: Vec<Realized> = Vec::new();
+    let mut best = (f64::INFINITY, f64::INFINITY);
+    for start in 0..starts.max(1) {
+        let mut y0 = DVector::zeros(lay.unknowns);
+        for (k, s) in problem.springs.iter().enumerate() {
+            let u = lay.start[k];
+            let (na, nb) = (s.axes_a.len(), s.axes_b.len());
+            let [klo, khi] = s.bounds.stiffness;
+            let klo_eff = if klo > 0.0 { klo } else { khi * 1e-3 };
+            let kk = if start == 0 && x[s.column] > 0.0 {
+                x[s.column].clamp(klo_eff, khi)
+            } else {
+                (rng.uniform(klo_eff.ln(), khi.ln())).exp()
+            };
+            y0[u] = kk.ln();
+            for (offset, n, range, lifted) in [
+                (1, na, s.bounds.anchor_a, s.column + 1),
+                (1 + na, nb, s.bounds.anchor_b, s.column + 1 + na),
+            ] {
+                if start == 0 {
+                    for i in 0..n {
+                        y0[u + offset + i] = x[lifted + i] / kk;
+                    }
+                } else {
+                    let len = rng.uniform(range[0], range[1]);
+                    let dir: Vec<f64> = (0..n).map(|_| rng.uniform(-1.0, 1.0)).collect();
+                    let dn = norm(&dir).max(1e-12);
+                    for i in 0..n {
+                        y0[u + offset + i] = dir[i] / dn * len;
+                    }
+                }
+            }
+        }
+        for (c, &u) in problem.counterweights.iter().zip(&lay.cw_start) {
+            let (big_m, big_r) = cw_scales(c);
+            y0[u] = x[c.column] / big_m;
+            for k in 0..c.axes.len() {
+                y0[u + 1 + k] = x[c.column + 1 + k] / big_r;
+            }
+        }
+        let target = y0.clone();
+        let (y1, _, _) = levenberg_marquardt(problem, b, x, &lay, y0, Some((&target, 1e-3)));
+        let (y, bal, hinge) = levenberg_marquardt(problem, b, x, &lay, y1, None);
+        if bal < best.0 {
+            best = (bal, hinge);
+        }
+        if bal <= SOLVED_TOL && hinge <= BOUND_TOL {
+            let v = values(problem, &lay, &y);
+            let duplicate = found.iter().any(|(f, _)| {
+                f.iter().zip(&v).all(|(p, q)| {
+                    (p.stiffness - q.stiffness).abs() <= 1e-6 * q.stiffness
+                        && (0..3).all(|i| {
+                            (p.anchor_a[i] - q.anchor_a[i]).abs() < 1e-6
+                                && (p.anchor_b[i] - q.anchor_b[i]).abs() < 1e-6
+                        })
+                })
+            });
+            if !duplicate {
+                let xl = lifted_with(problem, x, &lay, &y);
+                found.push((v, xl));
+            }
+        }
+    }
+    let note = if found.is_empty() {
+        format!(
+            "no spring parameters within the bounds balance the variant with these counterweights \
+             ({} starts; best relative balance residual {:.2e}, bound excess {:.2e})",
+            starts.max(1),
+            best.0,
+            best.1
+        )
+    } else {
+        String::new()
+    };
+    (found, note)
+}

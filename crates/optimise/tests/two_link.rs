@@ -1,0 +1,179 @@
+//! A one-parameter family with coupled counterweights: the two-link arm with counterweights on
+//! both links. Balance fixes `m2·r2 = −(M2 c2 + m_tool L2)` and couples the first link's to the
+//! second counterweight's mass, `m1·r1 = −(M1 c1 + (M2 + m_tool + m2) L1)`; the first mass is
+//! fixed by an override, so the family is one-dimensional in `m2`. The reference is a fine scan
+//! over `m2` of the true objective, evaluated with the dynamics crate directly from these
+//! formulas (not through this crate).
+
+mod common;
+
+use counterpoise_dynamics::params::{Counterweight, ParameterSet, Variant};
+use counterpoise_dynamics::{EvaluateOptions, evaluate_grid};
+use counterpoise_optimise::{OptimiseOptions, OptimisedStatus, objective_of};
+
+const M1: f64 = 4.0;
+const C1: f64 = 0.4;
+const M2: f64 = 2.5;
+const C2: f64 = 0.3;
+const TOOL: f64 = 1.0;
+const L1: f64 = 0.8;
+const L2: f64 = 0.6;
+const M1_FIXED: f64 = 12.0;
+
+fn case(m2_range: [f64; 2], peak: Option<f64>) -> serde_json::Value {
+    let mut json = common::case_json("two_link.json");
+    let b = &mut json["balancing"];
+    b.as_object_mut().unwrap().remove("springs");
+    b["bounds"] = serde_json::json!({ "mass": m2_range, "radius": [0.0, 2.0] });
+    b["overrides"] = serde_json::json!([{ "element": "m1", "mass": [M1_FIXED, M1_FIXED] }]);
+    if let Some(p) = peak {
+        b["peak_limits"] = serde_json::json!({ "M1": p });
+    }
+    json["tasks"]["samples"] = serde_json::json!(21);
+    json
+}
+
+/// The balanced variant for a given `m2` (counterweights on the x axes of both links).
+fn variant(m2: f64) -> Variant {
+    let mu2 = -(M2 * C2 + TOOL * L2);
+    let mu1 = -(M1 * C1 + (M2 + TOOL + m2) * L1);
+    Variant {
+        counterweights: vec![
+            Counterweight {
+                body: 0,
+                mass: M1_FIXED,
+                position: [mu1 / M1_FIXED, 0.0, 0.0],
+            },
+            Counterweight {
+                body: 1,
+                mass: m2,
+                position: [mu2 / m2, 0.0, 0.0],
+            },
+        ],
+        springs: Vec::new(),
+    }
+}
+
+fn scan(model: &counterpoise_model::Model, lo: f64, hi: f64, n: usize) -> Vec<(f64, f64, f64)> {
+    let masses: Vec<f64> = (0..=n)
+        .map(|k| lo + (hi - lo) * k as f64 / n as f64)
+        .collect();
+    let variants: Vec<Variant> = masses.iter().map(|&m| variant(m)).collect();
+    let params = ParameterSet::from_variants(model, &variants).unwrap();
+    let grid = evaluate_grid(
+        model,
+        &params,
+        &EvaluateOptions {
+            reactions: false,
+            ..EvaluateOptions::default()
+        },
+    )
+    .unwrap();
+    masses
+        .iter()
+        .zip(&grid.indicators)
+        .map(|(&m, ind)| {
+            let peak = ind.actuators[0].cpt_peak;
+            (
+                m,
+                objective_of(ind, counterpoise_optimise::Objective::RmsStar),
+                peak,
+            )
+        })
+        .collect()
+}
+
+fn best_of(points: &[(f64, f64, f64)], limit: Option<f64>) -> (f64, f64) {
+    points
+        .iter()
+        .filter(|p| limit.is_none_or(|l| p.2 <= l))
+        .fold((f64::NAN, f64::INFINITY), |b, p| {
+            if p.1 < b.1 { (p.0, p.1) } else { b }
+        })
+}
+
+/// Coarse scan, then a fine scan around the best point.
+fn fine_scan(
+    model: &counterpoise_model::Model,
+    lo: f64,
+    hi: f64,
+    limit: Option<f64>,
+) -> (f64, f64) {
+    let coarse = scan(model, lo, hi, 200);
+    let (m, _) = best_of(&coarse, limit);
+    let h = (hi - lo) / 200.0;
+    let fine = scan(model, (m - h).max(lo), (m + h).min(hi), 400);
+    best_of(&fine, limit)
+}
+
+#[test]
+fn one_free_mass_matches_a_fine_scan() {
+    let json = case([0.5, 40.0], None);
+    let model = common::model(&json);
+    let (_, results) = common::optimise(&model, &[&["m1", "m2"]], &OptimiseOptions::default());
+    let v = &results[0];
+    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    let m1 = v.counterweights.iter().find(|c| c.label == "m1").unwrap();
+    assert!(
+        (m1.mass - M1_FIXED).abs() <= 1e-9 * M1_FIXED,
+        "override kept: {}",
+        m1.mass
+    );
+    let m2 = v
+        .counterweights
+        .iter()
+        .find(|c| c.label == "m2")
+        .unwrap()
+        .mass;
+    let lo = 0.5_f64.max((M2 * C2 + TOOL * L2) / 2.0);
+    let (m_star, f_star) = fine_scan(&model, lo, 40.0, None);
+    let obj = v.objective.unwrap();
+    assert!(
+        (obj - f_star).abs() <= 1e-4 * f_star,
+        "objective {obj} vs scan {f_star} (m2 {m2} vs {m_star})"
+    );
+    assert!(
+        obj <= f_star * (1.0 + 1e-6),
+        "the solver should not be worse than the scan"
+    );
+    assert!(v.lower_bound.unwrap() <= obj * (1.0 + 1e-9));
+    assert!(v.verification.as_ref().unwrap().passed);
+}
+
+#[test]
+fn active_peak_limit_is_respected() {
+    // Unconstrained optimum first, then a limit on M1 below its peak there but above the
+    // smallest peak in the family: the limit becomes active.
+    let json = case([0.5, 40.0], None);
+    let model = common::model(&json);
+    let lo = 0.5_f64.max((M2 * C2 + TOOL * L2) / 2.0);
+    let points = scan(&model, lo, 40.0, 400);
+    let (m_free, _) = best_of(&points, None);
+    let peak_at_free = points.iter().find(|p| p.0 == m_free).unwrap().2;
+    let min_peak = points.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
+    assert!(
+        min_peak < peak_at_free * 0.999,
+        "the test needs a peak that the family can lower"
+    );
+    let limit = 0.5 * (min_peak + peak_at_free);
+    let json = case([0.5, 40.0], Some(limit));
+    let model = common::model(&json);
+    let (_, results) = common::optimise(&model, &[&["m1", "m2"]], &OptimiseOptions::default());
+    let v = &results[0];
+    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    let peak = v.indicators.as_ref().unwrap().actuators[0].cpt_peak;
+    assert!(
+        peak <= limit * (1.0 + 1e-9),
+        "peak {peak} above limit {limit}"
+    );
+    assert!(
+        peak >= limit * (1.0 - 1e-4),
+        "limit should be active: peak {peak}, limit {limit}"
+    );
+    let (_, f_star) = fine_scan(&model, lo, 40.0, Some(limit));
+    let obj = v.objective.unwrap();
+    assert!(
+        obj <= f_star * (1.0 + 1e-4),
+        "objective {obj} vs constrained scan {f_star}"
+    );
+}
