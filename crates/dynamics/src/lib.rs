@@ -20,6 +20,7 @@ pub mod law;
 pub mod lu;
 pub mod mechanism;
 pub mod params;
+pub mod paths;
 pub mod reactions;
 pub mod regressor;
 pub mod runner;
@@ -34,5 +35,6 @@ pub use evaluate::{
 };
 pub use indicators::{ActuatorIndicators, Indicators, JointIndicators, TaskStats};
 pub use params::{Counterweight, ParameterSet, Spring, SpringSlot, Variant};
+pub use paths::{PathSeries, path_series};
 pub use runner::Evaluator;
 pub use tasks::TaskSet;

@@ -117,3 +117,93 @@ fn counterweight_balancing_the_pendulum_leaves_no_static_torque() {
         assert!(ub.actuator_force[k][0].abs() > 0.5);
     }
 }
+
+#[test]
+fn base_spring_balancing_the_pendulum() {
+    use counterpoise_dynamics::Spring;
+    let model = case("pendulum");
+    // V_g = m g c sin θ = 9.81 sin θ; a zero-free-length spring from (0, B, 0) on the base to
+    // (A, 0, 0) on the rod adds −K A B sin θ: balanced for K A B = 9.81.
+    let (k, a, b) = (100.0, 0.1, 0.981);
+    let variant = Variant {
+        counterweights: vec![],
+        springs: vec![Spring {
+            body: 0,
+            other: None,
+            stiffness: k,
+            anchor: [a, 0.0, 0.0],
+            other_anchor: [0.0, b, 0.0],
+        }],
+    };
+    let params = ParameterSet::from_variants(&model, &[Variant::default(), variant]).unwrap();
+    let s = task_series_with(&model, &params, 1, 0, 4, Some(21)).unwrap();
+    let ub = task_series_with(&model, &params, 0, 0, 4, Some(21)).unwrap();
+    let (m, c, izz) = (2.0, 0.5, 0.1667);
+    for (i, &t) in s.t.iter().enumerate() {
+        let (th, thd, thdd) = quintic(-1.5, 1.5, 1.0, t);
+        // balanced: inertial torque only
+        let j = izz + m * c * c;
+        assert_close(
+            s.actuator_force[i][0],
+            j * thdd,
+            1e-9 * (1.0 + (j * thdd).abs()),
+            "balanced torque",
+        );
+        assert!(ub.actuator_force[i][0].abs() > 0.0);
+        // pivot force: m(a_G − g) minus the spring's pull on the rod, K(b − R a)
+        let ax = c * (-thdd * th.sin() - thd * thd * th.cos());
+        let ay = c * (thdd * th.cos() - thd * thd * th.sin());
+        let spring = [k * (0.0 - a * th.cos()), k * (b - a * th.sin())];
+        let f = ((m * ax - spring[0]).powi(2) + (m * (ay + G) - spring[1]).powi(2)).sqrt();
+        assert_close(
+            s.joints[0].force[i],
+            f,
+            1e-9 * (1.0 + f),
+            "pivot force with spring",
+        );
+    }
+}
+
+#[test]
+fn spring_generalized_force_is_the_gradient_of_its_energy() {
+    use counterpoise_dynamics::mechanism::{Mechanism, Scratch};
+    use counterpoise_dynamics::params::{SpringSlot, spring_params};
+    use counterpoise_dynamics::regressor::spring_regressor;
+    let model = case("two_link");
+    let mech = Mechanism::new(&model).unwrap();
+    let slot = SpringSlot {
+        body: 1,
+        other: Some(0),
+    };
+    let (k, a, b) = (750.0, [0.3, -0.1, 0.05], [-0.2, 0.4, 0.0]);
+    let x = spring_params(k, &a, &b);
+    let energy = |q: &[f64]| {
+        let at = model.point(q);
+        let pose = |i: usize| {
+            let body = &model.bodies[i];
+            let r = nalgebra::Matrix3::from_fn(|u, v| body.rotation.0[u][v].eval(&at));
+            let p = nalgebra::Vector3::from_fn(|u, _| body.origin.0[u].eval(&at));
+            (r, p)
+        };
+        let (ri, pi) = pose(1);
+        let (rs, ps) = pose(0);
+        let d = pi + ri * nalgebra::Vector3::from(a) - ps - rs * nalgebra::Vector3::from(b);
+        0.5 * k * d.norm_squared()
+    };
+    let mut scratch = Scratch::default();
+    let mut out = vec![0.0; 2 * 16];
+    for q in [[0.3, -0.7], [-1.2, 2.0], [2.5, 0.1]] {
+        mech.eval_poses(&q, &mut scratch);
+        spring_regressor(&mech, &scratch.pose, &slot, &mut out);
+        for kq in 0..2 {
+            let ours: f64 = (0..16).map(|c| out[kq * 16 + c] * x[c]).sum();
+            let h = 1e-6;
+            let mut qp = q;
+            let mut qm = q;
+            qp[kq] += h;
+            qm[kq] -= h;
+            let fd = (energy(&qp) - energy(&qm)) / (2.0 * h);
+            assert_close(ours, fd, 1e-6 * (1.0 + fd.abs()), "dV/dq");
+        }
+    }
+}

@@ -263,3 +263,60 @@ fn reversed_task_has_the_same_rms_and_peaks() {
         assert!(f.rms[2] > 1.0, "M3 carries gravity");
     }
 }
+
+/// A single counterweight on the upper arm that balances the palletizer exactly, derived from
+/// the model's potential `V = g(α2 sin θ2 + α3 sin θ3)`: the arm's origin B is at height
+/// `δ2 + δ1 sin θ2 − δ4 sin θ3`, so a mass `m` at `(r_x, 0)` in its frame adds
+/// `m g (δ1 sin θ2 + (r_x − δ4) sin θ3)`. At rest every actuator force vanishes.
+#[test]
+fn balanced_witness_has_no_static_torque() {
+    use counterpoise_dynamics::{Counterweight, Variant};
+    use counterpoise_symbolic::Monomial;
+    let model = case("palletizer");
+    let v = model.potential_energy(PayloadMode::All);
+    let (g_a2, g_a3) = (
+        v.coefficient(&Monomial::sine(1)),
+        v.coefficient(&Monomial::sine(2)),
+    );
+    assert!(
+        (g_a2 + 672.84).abs() < 0.01 && (g_a3 - 2830.49).abs() < 0.01,
+        "{g_a2} {g_a3}"
+    );
+    let (d1, d4, g) = (0.3, 0.25, 9.81);
+    let m = -g_a2 / (g * d1);
+    let rx = d4 - g_a3 / (m * g);
+    let arm = model.body_index("upper_arm").unwrap();
+    let variant = Variant {
+        counterweights: vec![Counterweight {
+            body: arm,
+            mass: m,
+            position: [rx, 0.0, 0.0],
+        }],
+        springs: vec![],
+    };
+    let params = ParameterSet::from_variants(&model, &[Variant::default(), variant]).unwrap();
+    let ev = Evaluator::new(&model).unwrap();
+    let zeros = vec![0.0; 3];
+    let mut rng = SplitMix64::new(5);
+    for _ in 0..5 {
+        let (q, _, _) = random_state(&model, &mut rng);
+        let view = ev
+            .at_state(&q, &zeros, &zeros, &params, &[0, 1], true)
+            .unwrap();
+        let ub = view.actuator_force[0];
+        let bal = view.actuator_force[1];
+        assert!(
+            ub[2].abs() > 1000.0,
+            "the unbalanced M3 carries the weight: {}",
+            ub[2]
+        );
+        for a in 0..3 {
+            assert!(
+                bal[a].abs() < 1e-9 * ub[2].abs(),
+                "actuator {a}: {} (unbalanced {})",
+                bal[a],
+                ub[a]
+            );
+        }
+    }
+}
