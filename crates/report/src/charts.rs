@@ -32,8 +32,10 @@ pub fn class_color(class: Option<Class>) -> &'static str {
     }
 }
 
-/// Most variants shown in one bar chart (the table lists all of them).
-pub const MAX_BARS: usize = 40;
+/// Variants per bar chart: 16 groups fit the page width without shrinking the text.
+pub const BARS_PER_CHART: usize = 16;
+/// Most variants of one class shown as bars (the ranking table lists all of them).
+pub const MAX_BARS: usize = 48;
 
 /// Every chart of the report, in display order.
 pub fn all(r: &RunResults) -> Vec<Chart> {
@@ -64,26 +66,32 @@ pub fn all(r: &RunResults) -> Vec<Chart> {
     charts
 }
 
-/// Fig. 7: ΔQTR, ΔQIT, ΔR of each variant of a class, best on the left.
+/// Fig. 7: ΔQTR, ΔQIT, ΔR of each variant of a class, best on the left; long classes are
+/// split into charts of [`BARS_PER_CHART`] variants.
 fn ranking_bars(r: &RunResults) -> Vec<Chart> {
     let ranked = r.ranked();
-    Class::ALL
-        .iter()
-        .filter_map(|&class| {
-            let mut vs: Vec<_> = ranked.iter().filter(|v| v.class == class).collect();
-            if vs.is_empty() {
-                return None;
-            }
-            vs.sort_by_key(|v| v.class_rank);
-            let shown = vs.len().min(MAX_BARS);
-            let mut title = format!("{} — ranking indicators", class.title());
-            if vs.len() > shown {
-                title.push_str(&format!(" (best {shown} of {})", vs.len()));
-            }
+    let mut charts = Vec::new();
+    for class in Class::ALL {
+        let mut vs: Vec<_> = ranked.iter().filter(|v| v.class == class).collect();
+        vs.sort_by_key(|v| v.class_rank);
+        let total = vs.len();
+        vs.truncate(MAX_BARS);
+        let chunks = vs.len().div_ceil(BARS_PER_CHART);
+        for (k, chunk) in vs.chunks(BARS_PER_CHART).enumerate() {
+            let title = if chunks == 1 && total == vs.len() {
+                format!("{} — ranking indicators", class.title())
+            } else {
+                let first = k * BARS_PER_CHART + 1;
+                format!(
+                    "{} — class ranks {first}–{} of {total}",
+                    class.title(),
+                    first + chunk.len() - 1
+                )
+            };
             let chart = BarChart {
                 title: title.clone(),
                 y_label: "variation vs unbalanced [%]".into(),
-                categories: vs[..shown]
+                categories: chunk
                     .iter()
                     .map(|v| (v.name.clone().unwrap_or_default(), v.label()))
                     .collect(),
@@ -92,7 +100,7 @@ fn ranking_bars(r: &RunResults) -> Vec<Chart> {
                     ("ΔQIT (total peak torque)".into(), "#56B4E9".into()),
                     ("ΔR (joint reactions)".into(), "#E69F00".into()),
                 ],
-                values: vs[..shown]
+                values: chunk
                     .iter()
                     .map(|v| {
                         vec![
@@ -105,13 +113,14 @@ fn ranking_bars(r: &RunResults) -> Vec<Chart> {
                 min_width: 560.0,
                 height: 340.0,
             };
-            Some(Chart {
+            charts.push(Chart {
                 section: Section::Ranking,
                 title,
                 svg: bar_chart(&chart),
-            })
-        })
-        .collect()
+            });
+        }
+    }
+    charts
 }
 
 fn curve_class(r: &RunResults, variant: Option<usize>) -> Option<Class> {

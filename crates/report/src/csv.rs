@@ -1,5 +1,5 @@
 //! ranking.csv: one row per feasible variant in rank order, for spreadsheets and scripts.
-//! Full precision (Rust's shortest round-trip formatting), SI units, empty fields for values the
+//! Full precision (shortest round-trip formatting, `1.5e-13` style for tiny values), SI units, empty fields for values the
 //! optimiser did not report.
 
 use crate::format::csv_field;
@@ -29,7 +29,8 @@ pub const HEADER: [&str; 16] = [
 pub fn render(r: &RunResults) -> String {
     let mut s = HEADER.join(",");
     s.push('\n');
-    let num = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
+    // Debug formatting is Rust's shortest round-trip form, with an exponent for tiny values.
+    let num = |x: Option<f64>| x.map(|v| format!("{v:?}")).unwrap_or_default();
     for v in r.ranked() {
         let o = v.optimiser.clone().unwrap_or_default();
         let e = v.evaluation.as_ref();

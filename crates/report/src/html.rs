@@ -23,6 +23,8 @@ p.sub, p.note, .muted { color: var(--muted); }
 p.note { font-size: 13px; max-width: 900px; }
 table { border-collapse: collapse; margin: 6px 0 14px; font-variant-numeric: tabular-nums; }
 th, td { padding: 4px 10px; border-bottom: 1px solid var(--line); text-align: left; vertical-align: top; }
+td { white-space: nowrap; }
+td.p { white-space: normal; min-width: 220px; }
 th { background: var(--band); font-weight: 600; vertical-align: bottom; }
 .scroll { overflow-x: auto; max-width: 100%; }
 td.n { text-align: right; white-space: nowrap; }
@@ -271,6 +273,8 @@ fn table(t: &Table, class: &str) -> String {
         for cell in row {
             if cell.numeric {
                 let _ = write!(s, "<td class=\"n\">{}</td>", esc(&cell.text));
+            } else if cell.prose {
+                let _ = write!(s, "<td class=\"p\">{}</td>", esc(&cell.text));
             } else {
                 let _ = write!(s, "<td>{}</td>", esc(&cell.text));
             }

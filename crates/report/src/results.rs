@@ -101,13 +101,14 @@ impl VariantStatus {
     }
 }
 
-/// Plane in which a counterweight offset or spring anchor lies, for polar display (Table 1).
+/// Plane in which a counterweight offset or spring anchor lies, for polar display (Table 1);
+/// the same names as the case file's `plane`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Plane {
     Xy,
     Yz,
-    Zx,
+    Xz,
 }
 
 impl Plane {
@@ -116,7 +117,7 @@ impl Plane {
         match self {
             Plane::Xy => (0, 1),
             Plane::Yz => (1, 2),
-            Plane::Zx => (2, 0),
+            Plane::Xz => (0, 2),
         }
     }
 }

@@ -298,7 +298,9 @@ pub fn line_chart(chart: &LineChart) -> String {
         height - 10.0,
         escape_html(&chart.x_label)
     );
-    for s in &chart.series {
+    // Drawn last-to-first so the first series (the reference, dashed) lies on top and stays
+    // visible where a variant's curve coincides with it.
+    for s in chart.series.iter().rev() {
         let mut points = String::new();
         for (x, y) in s.x.iter().zip(&s.y) {
             if x.is_finite() && y.is_finite() {

@@ -4,11 +4,13 @@
 use crate::format::{angle, compact, fixed, percent, polar, seconds, task, value};
 use crate::results::{PathSimulation, RunResults, VariantRecord, VariantStatus};
 
-/// One cell: text, and whether it is a number (right-aligned).
+/// One cell: text, whether it is a number (right-aligned) and whether it is prose that may wrap
+/// (everything else stays on one line, so labels like `K42 + K43` never break).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cell {
     pub text: String,
     pub numeric: bool,
+    pub prose: bool,
 }
 
 impl Cell {
@@ -16,12 +18,21 @@ impl Cell {
         Cell {
             text: s.into(),
             numeric: false,
+            prose: false,
         }
     }
     pub fn num(s: impl Into<String>) -> Cell {
         Cell {
             text: s.into(),
             numeric: true,
+            prose: false,
+        }
+    }
+    pub fn prose(s: impl Into<String>) -> Cell {
+        Cell {
+            text: s.into(),
+            numeric: false,
+            prose: true,
         }
     }
     pub fn empty() -> Cell {
@@ -49,6 +60,35 @@ impl Table {
         debug_assert_eq!(row.len(), self.header.len());
         self.rows.push(row);
         self.group_starts.push(group_start);
+    }
+
+    /// Removes columns that are empty in every row (e.g. the optimiser's columns when it
+    /// reported nothing, or the spring columns of a counterweight-only Table 1).
+    fn without_empty_columns(mut self) -> Table {
+        if self.rows.is_empty() {
+            return self;
+        }
+        let keep: Vec<bool> = (0..self.header.len())
+            .map(|c| self.rows.iter().any(|r| !r[c].text.is_empty()))
+            .collect();
+        let filter = |v: Vec<Cell>| -> Vec<Cell> {
+            v.into_iter()
+                .zip(&keep)
+                .filter(|(_, k)| **k)
+                .map(|(c, _)| c)
+                .collect()
+        };
+        self.header = std::mem::take(&mut self.header)
+            .into_iter()
+            .zip(&keep)
+            .filter(|(_, k)| **k)
+            .map(|(h, _)| h)
+            .collect();
+        self.rows = std::mem::take(&mut self.rows)
+            .into_iter()
+            .map(filter)
+            .collect();
+        self
     }
 }
 
@@ -178,7 +218,7 @@ pub fn counts(r: &RunResults) -> Table {
         for (s, x) in sums.iter_mut().zip(n) {
             *s += x;
         }
-        let mut row = vec![Cell::text(c.status.name()), Cell::text(c.status.meaning())];
+        let mut row = vec![Cell::text(c.status.name()), Cell::prose(c.status.meaning())];
         row.extend(n.iter().map(|x| Cell::num(x.to_string())));
         t.push(row, false);
     }
@@ -235,7 +275,7 @@ pub fn ranking(r: &RunResults) -> Table {
             false,
         );
     }
-    t
+    t.without_empty_columns()
 }
 
 /// The paper's Table 1: optimised parameters of the feasible variants, one row per element,
@@ -291,7 +331,7 @@ pub fn parameters(r: &RunResults) -> Table {
             first = false;
         }
     }
-    t
+    t.without_empty_columns()
 }
 
 /// (length, angle) of a body-frame vector: polar in its plane when known (Table 1 style),
@@ -391,7 +431,7 @@ pub fn joint_reactions(r: &RunResults) -> Table {
             );
         }
     }
-    t
+    t.without_empty_columns()
 }
 
 /// Balanced variants that were not ranked, and why (infeasible ones are only counted).
@@ -409,7 +449,7 @@ pub fn not_ranked(r: &RunResults) -> Table {
                 Cell::text(v.label()),
                 Cell::text(v.class.name()),
                 Cell::text(v.status.name()),
-                Cell::text(v.reason.clone().unwrap_or_default()),
+                Cell::prose(v.reason.clone().unwrap_or_default()),
             ],
             false,
         );
