@@ -3,8 +3,10 @@
 //!
 //! This package is the command-line tool and a facade over the stage crates:
 //! [`symbolic`] (trigonometric-polynomial algebra), [`model`] (case format, validation,
-//! kinematics), [`balance`] (exact balancing search).
+//! kinematics), [`balance`] (exact balancing search), [`dynamics`] (inverse dynamics and
+//! indicators over tasks).
 
 pub use counterpoise_balance as balance;
+pub use counterpoise_dynamics as dynamics;
 pub use counterpoise_model as model;
 pub use counterpoise_symbolic as symbolic;

@@ -35,6 +35,26 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Phase 1: motor torques, joint reactions and the paper's indicators of the unbalanced
+    /// mechanism over its task grid.
+    Evaluate {
+        case: PathBuf,
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Samples per task (default: the case's `tasks.samples`).
+        #[arg(long)]
+        samples: Option<usize>,
+        /// Skip the joint reactions (motor torques only: much faster).
+        #[arg(long)]
+        no_reactions: bool,
+        /// One task `I,J` (grid indices) to write as a time series with --series.
+        #[arg(long, value_parser = parse_task, requires = "series")]
+        task: Option<(usize, usize)>,
+        /// File for the time series of --task (JSON).
+        #[arg(long, requires = "task")]
+        series: Option<PathBuf>,
+    },
     /// The whole case study: balance, optimise, rank, report (not yet available).
     Run {
         case: PathBuf,
@@ -63,6 +83,22 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Check { case } => commands::check::run(&case),
         Command::Variants { case, dmax, json } => commands::variants::run(&case, dmax, json),
+        Command::Evaluate {
+            case,
+            json,
+            samples,
+            no_reactions,
+            task,
+            series,
+        } => commands::evaluate::run(
+            &case,
+            commands::evaluate::Options {
+                json,
+                samples,
+                no_reactions,
+                series: task.zip(series.as_deref()),
+            },
+        ),
         Command::Run { .. } => {
             eprintln!(
                 "counterpoise run: not yet available — the optimisation and report stages are \
@@ -78,4 +114,17 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `I,J` → grid indices of a task.
+fn parse_task(text: &str) -> Result<(usize, usize), String> {
+    let (i, j) = text
+        .split_once(',')
+        .ok_or_else(|| format!("expected I,J (two grid indices), found `{text}`"))?;
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("`{s}` is not a grid index"))
+    };
+    Ok((parse(i)?, parse(j)?))
 }

@@ -99,3 +99,43 @@ fn variants_are_identical_with_one_and_two_threads() {
     };
     assert_eq!(strip(&one), strip(&two));
 }
+
+#[test]
+fn evaluate_series_of_the_pendulum_matches_its_equation_of_motion() {
+    // rod: m = 2 kg, CoM at L/2 = 0.5 m, I_zz about the CoM 0.1667 kg·m², ratio 0.01;
+    // grid −1.5…1.5 rad in 5 points; move 0 → 4 is −1.5 → 1.5 rad in 1 s (quintic).
+    let dir = std::env::temp_dir().join(format!("counterpoise-series-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("series.json");
+    let out = counterpoise(&[
+        "evaluate",
+        "cases/pendulum.json",
+        "--task",
+        "0,4",
+        "--series",
+        file.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    let (m, c, g, i_zz, ratio) = (2.0, 0.5, 9.81, 0.1667, 0.01);
+    let t = s["t"].as_array().unwrap();
+    assert_eq!(t.len(), 21);
+    for (k, tk) in t.iter().enumerate() {
+        let tau = tk.as_f64().unwrap(); // duration 1 s
+        let (q0, dq) = (-1.5, 3.0);
+        let s5 = 10.0 * tau.powi(3) - 15.0 * tau.powi(4) + 6.0 * tau.powi(5);
+        let a5 = 60.0 * tau - 180.0 * tau.powi(2) + 120.0 * tau.powi(3);
+        let (q, qdd) = (q0 + dq * s5, dq * a5);
+        // τ = (I_zz + m c²) q̈ + m g c cos q
+        let expected = (i_zz + m * c * c) * qdd + m * g * c * q.cos();
+        let force = s["actuator_force"][k][0].as_f64().unwrap();
+        assert!(
+            (force - expected).abs() < 1e-6 * (1.0 + expected.abs()),
+            "t={tau}: {force} vs {expected}"
+        );
+        let motor = s["motor_torque"][k][0].as_f64().unwrap();
+        assert!((motor - ratio * expected).abs() < 1e-8 * (1.0 + expected.abs()));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

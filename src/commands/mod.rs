@@ -1,6 +1,7 @@
 //! One module per subcommand.
 
 pub mod check;
+pub mod evaluate;
 pub mod variants;
 
 use std::path::Path;
@@ -21,4 +22,25 @@ pub fn load(path: &Path) -> Result<Option<Model>> {
             Ok(None)
         }
     }
+}
+
+/// Writes a file atomically: a temporary file in the same directory, flushed, then renamed over
+/// the target, so a reader never sees a half-written file.
+pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
+    use std::io::Write;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| anyhow::anyhow!("{}: not a file path", path.display()))?;
+    let tmp = dir.join(format!(".{}.tmp", name.to_string_lossy()));
+    let mut file = std::fs::File::create(&tmp)
+        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", tmp.display()))?;
+    file.write_all(contents)?;
+    file.sync_all()?;
+    std::fs::rename(&tmp, path)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    Ok(())
 }
