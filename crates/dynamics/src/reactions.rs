@@ -116,6 +116,8 @@ pub struct ReactionSolver {
     /// Rank of `A` at the reference configuration.
     pub rank: usize,
     fast: bool,
+    /// Rows of `A` each column can touch (the rows of the joint's bodies).
+    pattern: Vec<Vec<usize>>,
 }
 
 impl ReactionSolver {
@@ -153,7 +155,23 @@ impl ReactionSolver {
             minimum_norm: false,
             rank: 0,
             fast: false,
+            pattern: Vec::new(),
         };
+        for j in &solver.joints {
+            let (f, m) = j.counts();
+            for c in 0..f + m {
+                let part = if c < f { 0..6 } else { 3..6 };
+                let mut rows: Vec<usize> = Vec::new();
+                for side in j.bodies {
+                    if let BodyId::Body(b) = side {
+                        rows.extend(part.clone().map(|r| 6 * b + r));
+                    }
+                }
+                rows.sort_unstable();
+                rows.dedup();
+                solver.pattern.push(rows);
+            }
+        }
         // Rank and null-space check at the reference configuration.
         let q = model.reference_configuration();
         let mut scratch = Scratch::default();
@@ -404,7 +422,6 @@ impl ReactionSolver {
         work.kappas = self.kappas(&work.frames, kin, lu, mech.n);
         work.a.clear();
         work.a.resize(rows * k, 0.0);
-        work.nz.resize(k, Vec::new());
         for (j, f) in self.joints.iter().zip(&work.frames) {
             let mut col = j.offset;
             for e in &f.forces {
@@ -430,10 +447,14 @@ impl ReactionSolver {
                 col += 1;
             }
         }
-        for c in 0..k {
-            let nz = &mut work.nz[c];
-            nz.clear();
-            nz.extend((0..rows).filter(|&r| work.a[c * rows + r] != 0.0));
+        if work.nz.len() != k
+            || work
+                .nz
+                .iter()
+                .zip(&self.pattern)
+                .any(|(a, b)| a.len() != b.len())
+        {
+            work.nz.clone_from(&self.pattern);
         }
         work.pinv = None;
         if self.fast {
@@ -450,15 +471,15 @@ impl ReactionSolver {
                     }
                 }
             }
-            let u = mobility_basis(kin, mech.n);
-            for c in 0..u.ncols() {
-                for r1 in 0..rows {
-                    let x = u[(r1, c)];
+            let count = mobility_basis_flat(kin, mech.n, &mut work.u);
+            for uc in work.u.chunks_exact(rows).take(count) {
+                for (r1, &x) in uc.iter().enumerate() {
                     if x == 0.0 {
                         continue;
                     }
-                    for r2 in 0..=r1 {
-                        work.l[r1 * rows + r2] += x * u[(r2, c)];
+                    let row = &mut work.l[r1 * rows..r1 * rows + r1 + 1];
+                    for (v, &y) in row.iter_mut().zip(uc) {
+                        *v += x * y;
                     }
                 }
             }
@@ -606,6 +627,8 @@ pub struct ReactionWork {
     a: Vec<f64>,
     /// Non-zero rows of each column of `A`.
     nz: Vec<Vec<usize>>,
+    /// Orthonormal mobility basis, column-major.
+    u: Vec<f64>,
     /// Lower Cholesky factor of `AAᵀ + UUᵀ`, row-major.
     l: Vec<f64>,
     /// `Lᵀ`, row-major.
@@ -660,10 +683,41 @@ fn cholesky_in_place(l: &mut [f64], n: usize) -> bool {
 }
 }
 
+/// `acc += x · v` on eight lanes.
+#[inline(always)]
+fn axpy8(acc: &mut [f64; 8], x: f64, v: &[f64; 8]) {
+    for p in 0..8 {
+        acc[p] += x * v[p];
+    }
+}
+
+/// `Σ_j w[j] · v[j]` over eight lanes with four interleaved partial sums (independent
+/// dependency chains; fixed order).
+#[inline(always)]
+fn combo8(w: &[f64], v: &[[f64; 8]]) -> [f64; 8] {
+    let mut s = [[0.0; 8]; 4];
+    let chunks = w.chunks_exact(4);
+    let rem = chunks.remainder();
+    for (wc, vc) in chunks.zip(v.chunks_exact(4)) {
+        axpy8(&mut s[0], wc[0], &vc[0]);
+        axpy8(&mut s[1], wc[1], &vc[1]);
+        axpy8(&mut s[2], wc[2], &vc[2]);
+        axpy8(&mut s[3], wc[3], &vc[3]);
+    }
+    let tail = w.len() - rem.len();
+    for (k, &x) in rem.iter().enumerate() {
+        axpy8(&mut s[k], x, &v[tail + k]);
+    }
+    let mut out = [0.0; 8];
+    for p in 0..8 {
+        out[p] = (s[0][p] + s[1][p]) + (s[2][p] + s[3][p]);
+    }
+    out
+}
+
 crate::simd::multiversion! {
 /// `y = Aᵀ (L Lᵀ)⁻¹ b` for `m` right-hand sides (`b` row-major `rows × m`; `y` row-major
-/// `k × m`; `lt` = `Lᵀ` row-major). Right-hand sides go in passes of up to 48, held as groups
-/// of eight lanes whose independent dependency chains keep the vector units busy.
+/// `k × m`; `lt` = `Lᵀ` row-major), eight right-hand sides at a time.
 fn chunk_solve(
     l: &[f64],
     lt: &[f64],
@@ -676,104 +730,77 @@ fn chunk_solve(
     y: &mut [f64],
     z: &mut Vec<[f64; 8]>,
 ) {
-    let mut c0 = 0;
-    while c0 < m {
-        let groups = (m - c0).div_ceil(8).min(6);
-        match groups {
-            1 => solve_pass::<1>(l, lt, rows, a, nz, k, b, m, c0, y, z),
-            2 => solve_pass::<2>(l, lt, rows, a, nz, k, b, m, c0, y, z),
-            3 => solve_pass::<3>(l, lt, rows, a, nz, k, b, m, c0, y, z),
-            4 => solve_pass::<4>(l, lt, rows, a, nz, k, b, m, c0, y, z),
-            5 => solve_pass::<5>(l, lt, rows, a, nz, k, b, m, c0, y, z),
-            _ => solve_pass::<6>(l, lt, rows, a, nz, k, b, m, c0, y, z),
+    z.resize(rows, [0.0; 8]);
+    for c0 in (0..m).step_by(8) {
+        let width = 8.min(m - c0);
+        // L z = b
+        for i in 0..rows {
+            let s = combo8(&l[i * rows..i * rows + i], &z[..i]);
+            let d = 1.0 / l[i * rows + i];
+            let mut zi = [0.0; 8];
+            for p in 0..width {
+                zi[p] = (b[i * m + c0 + p] - s[p]) * d;
+            }
+            z[i] = zi;
         }
-        c0 += 8 * groups;
+        // Lᵀ y = z
+        for i in (0..rows).rev() {
+            let s = combo8(&lt[i * rows + i + 1..(i + 1) * rows], &z[i + 1..rows]);
+            let d = 1.0 / l[i * rows + i];
+            let mut yi = z[i];
+            for p in 0..8 {
+                yi[p] = (yi[p] - s[p]) * d;
+            }
+            z[i] = yi;
+        }
+        // λ = Aᵀ y
+        for c in 0..k {
+            let col = &a[c * rows..(c + 1) * rows];
+            let mut acc = [0.0; 8];
+            for &r in &nz[c] {
+                axpy8(&mut acc, col[r], &z[r]);
+            }
+            y[c * m + c0..c * m + c0 + width].copy_from_slice(&acc[..width]);
+        }
     }
 }
-}
-
-#[inline(always)]
-fn solve_pass<const G: usize>(
-    l: &[f64],
-    lt: &[f64],
-    rows: usize,
-    a: &[f64],
-    nz: &[Vec<usize>],
-    k: usize,
-    b: &[f64],
-    m: usize,
-    c0: usize,
-    y: &mut [f64],
-    z: &mut Vec<[f64; 8]>,
-) {
-    let width = (8 * G).min(m - c0);
-    z.resize(rows * G, [0.0; 8]);
-    // L z = b
-    for i in 0..rows {
-        let mut acc = [[0.0; 8]; G];
-        for c in 0..width {
-            acc[c / 8][c % 8] = b[i * m + c0 + c];
-        }
-        let li = &l[i * rows..i * rows + i];
-        for (j, &x) in li.iter().enumerate() {
-            let zj = &z[j * G..(j + 1) * G];
-            for g in 0..G {
-                for p in 0..8 {
-                    acc[g][p] -= x * zj[g][p];
-                }
-            }
-        }
-        let d = 1.0 / l[i * rows + i];
-        for g in 0..G {
-            for p in 0..8 {
-                acc[g][p] *= d;
-            }
-        }
-        z[i * G..(i + 1) * G].copy_from_slice(&acc);
-    }
-    // Lᵀ y = z
-    for i in (0..rows).rev() {
-        let mut acc = [[0.0; 8]; G];
-        acc.copy_from_slice(&z[i * G..(i + 1) * G]);
-        let ci = &lt[i * rows + i + 1..(i + 1) * rows];
-        for (jj, &x) in ci.iter().enumerate() {
-            let j = i + 1 + jj;
-            let zj = &z[j * G..(j + 1) * G];
-            for g in 0..G {
-                for p in 0..8 {
-                    acc[g][p] -= x * zj[g][p];
-                }
-            }
-        }
-        let d = 1.0 / l[i * rows + i];
-        for g in 0..G {
-            for p in 0..8 {
-                acc[g][p] *= d;
-            }
-        }
-        z[i * G..(i + 1) * G].copy_from_slice(&acc);
-    }
-    // λ = Aᵀ y
-    for c in 0..k {
-        let col = &a[c * rows..(c + 1) * rows];
-        let mut acc = [[0.0; 8]; G];
-        for &r in &nz[c] {
-            let x = col[r];
-            let zr = &z[r * G..(r + 1) * G];
-            for g in 0..G {
-                for p in 0..8 {
-                    acc[g][p] += x * zr[g][p];
-                }
-            }
-        }
-        for cc in 0..width {
-            y[c * m + c0 + cc] = acc[cc / 8][cc % 8];
-        }
-    }
 }
 
 /// Orthonormal basis of the body velocity Jacobian `[J_v; J_ω]` (`6L × n`), modified
 /// Gram–Schmidt; columns that vanish are dropped.
+/// The same basis into a flat column-major buffer (`rows × count`); returns `count`.
+fn mobility_basis_flat(kin: &[BodyKin], n: usize, u: &mut Vec<f64>) -> usize {
+    let rows = 6 * kin.len();
+    u.clear();
+    u.resize(rows * n, 0.0);
+    let mut count = 0;
+    for k in 0..n {
+        let (done, rest) = u.split_at_mut(count * rows);
+        let v = &mut rest[..rows];
+        for (b, bk) in kin.iter().enumerate() {
+            for r in 0..3 {
+                v[6 * b + r] = bk.jv[k][r];
+                v[6 * b + 3 + r] = bk.jw[k][r];
+            }
+        }
+        let scale = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        for c in done.chunks_exact(rows) {
+            let d: f64 = c.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
+            for (x, y) in v.iter_mut().zip(c) {
+                *x -= d * y;
+            }
+        }
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm > 1e-10 * scale.max(1e-300) {
+            for x in v.iter_mut() {
+                *x /= norm;
+            }
+            count += 1;
+        }
+    }
+    count
+}
+
 fn mobility_basis(kin: &[BodyKin], n: usize) -> DMatrix<f64> {
     let rows = 6 * kin.len();
     let mut cols: Vec<DVector<f64>> = Vec::with_capacity(n);
