@@ -22,8 +22,8 @@ pub fn escape_html(s: &str) -> String {
     out
 }
 
-/// Escapes text for a Markdown table cell (pipes, newlines, and HTML-significant characters,
-/// since Markdown renderers pass raw HTML through).
+/// Escapes text for a Markdown table cell (pipes, newlines, emphasis and code markers, and
+/// HTML-significant characters, since Markdown renderers pass raw HTML through).
 pub fn escape_md(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
@@ -33,7 +33,9 @@ pub fn escape_md(s: &str) -> String {
             '<' => out.push_str("&lt;"),
             '>' => out.push_str("&gt;"),
             '&' => out.push_str("&amp;"),
-            '*' | '_' | '`' | '[' | ']' | '\\' => {
+            // `_` (GFM ignores it inside words) and brackets (no link without `(…)` after
+            // them) stay as they are so the raw file reads well in a terminal.
+            '*' | '`' | '\\' => {
                 out.push('\\');
                 out.push(c);
             }

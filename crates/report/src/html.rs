@@ -27,7 +27,8 @@ td { white-space: nowrap; }
 td.p { white-space: normal; min-width: 220px; }
 th { background: var(--band); font-weight: 600; vertical-align: bottom; }
 .scroll { overflow-x: auto; max-width: 100%; }
-td.n { text-align: right; white-space: nowrap; }
+td.n, th.n { text-align: right; }
+td.n { white-space: nowrap; }
 tr.g td { border-top: 2px solid #b9c2c9; }
 table.kv th { display: none; }
 table.kv td:first-child { color: var(--muted); padding-right: 18px; }
@@ -264,8 +265,13 @@ fn table(t: &Table, class: &str) -> String {
         let _ = write!(s, "<table class=\"{class}\">");
     }
     s.push_str("<thead><tr>");
-    for head in &t.header {
-        let _ = write!(s, "<th>{}</th>", esc(head));
+    for (c, head) in t.header.iter().enumerate() {
+        // Headers of number columns align with their numbers.
+        if t.rows.iter().any(|r| r[c].numeric) {
+            let _ = write!(s, "<th class=\"n\">{}</th>", esc(head));
+        } else {
+            let _ = write!(s, "<th>{}</th>", esc(head));
+        }
     }
     s.push_str("</tr></thead><tbody>");
     for (row, &group) in t.rows.iter().zip(&t.group_starts) {

@@ -542,3 +542,26 @@ fn output_is_deterministic() {
         counterpoise_report::csv::render(&shuffled)
     );
 }
+
+#[test]
+fn full_ties_are_flagged_and_listed() {
+    // Two counterweight variants with identical indicators: the labels decide, and both the
+    // records and the ranking info say so.
+    let mut r = sample();
+    let e = r.variant(4).unwrap().evaluation.clone().unwrap();
+    let mut twin = feasible(5, &["m4", "m3"], Class::Counterweights, e);
+    twin.relations.clear();
+    r.variants.push(twin);
+    r.finalize(&RankingOptions::default()).unwrap();
+    let (a, b) = (r.variant(4).unwrap(), r.variant(5).unwrap());
+    assert!(a.tie_broken_by_label && b.tie_broken_by_label);
+    // "m4 + m3" < "m4 + m6".
+    assert_eq!(b.rank.unwrap() + 1, a.rank.unwrap());
+    assert_eq!(r.ranking.as_ref().unwrap().tie_groups, vec![vec![5, 4]]);
+    assert!(!r.variant(3).unwrap().tie_broken_by_label);
+    let html = counterpoise_report::html::render(&r);
+    assert!(
+        html.contains("Tied on all three criteria: SB5 = SB6."),
+        "{html}"
+    );
+}
