@@ -21,14 +21,25 @@
 //! - `reactions_minimum_norm`: true when the mechanism is overconstrained and the reactions are
 //!   the minimum-norm solution (then `F_j`, `M_j` are one admissible distribution, not the
 //!   unique one).
+//! - `cyclic_coordinate`: the chart coordinate found cyclic (a rotation of the whole mechanism
+//!   about a gravity-parallel axis, e.g. the palletizer's `th1`) and factored out of the task
+//!   loop, or `null`. Tasks that differ only by such a rotation have identical indicators; the
+//!   critical task reported is then the lowest-indexed of them.
 //!
 //! Grid indices count grid points with the first actuator varying slowest, each actuator's
 //! values running from `from` to `to`.
 //!
+//! Torques and reactions are those of rigid bodies without friction; RMS values are over the
+//! task's samples with equal weights (both ends included).
+//!
 //! [`Series`] (JSON, one task): `task` `[from, to]`, `t` (s), `u[k][a]` (actuated coordinates),
 //! `q[k][c]` (chart coordinates), `actuator_force[k][a]` (generalized force along actuated
 //! coordinate `a`, N·m or N, before the ratio), `motor_torque[k][a]` (N·m), `joints[]` with
-//! `name`, `force[k]` (N) and `moment[k]` (N·m) magnitudes.
+//! `name`, `force[k]` (N) and `moment[k]` (N·m) magnitudes, `reactions_minimum_norm`.
+//!
+//! Paths (waypoint sequences with a payload, [`crate::paths::path_series`]) give a
+//! [`crate::paths::PathSeries`] with the same fields plus `carried[k]`, and `rms`, `peak` per
+//! actuator over the whole path.
 
 use std::collections::BTreeMap;
 

@@ -458,16 +458,21 @@ impl ReactionSolver {
         }
         work.pinv = None;
         if self.fast {
-            // S = A Aᵀ + U Uᵀ, lower Cholesky in place.
-            work.l.clear();
-            work.l.resize(rows * rows, 0.0);
+            // S = A Aᵀ + U Uᵀ (upper triangle, row-major), then S = Rᵀ R in place with
+            // R = Lᵀ upper triangular.
+            work.lt.clear();
+            work.lt.resize(rows * rows, 0.0);
             for c in 0..k {
                 let col = &work.a[c * rows..(c + 1) * rows];
-                for &r1 in &work.nz[c] {
-                    for &r2 in &work.nz[c] {
-                        if r2 <= r1 {
-                            work.l[r1 * rows + r2] += col[r1] * col[r2];
-                        }
+                let nz = &work.nz[c];
+                for (i, &r1) in nz.iter().enumerate() {
+                    let x = col[r1];
+                    if x == 0.0 {
+                        continue;
+                    }
+                    let row = &mut work.lt[r1 * rows..(r1 + 1) * rows];
+                    for &r2 in &nz[i..] {
+                        row[r2] += x * col[r2];
                     }
                 }
             }
@@ -477,19 +482,13 @@ impl ReactionSolver {
                     if x == 0.0 {
                         continue;
                     }
-                    let row = &mut work.l[r1 * rows..r1 * rows + r1 + 1];
-                    for (v, &y) in row.iter_mut().zip(uc) {
+                    let row = &mut work.lt[r1 * rows + r1..(r1 + 1) * rows];
+                    for (v, &y) in row.iter_mut().zip(&uc[r1..]) {
                         *v += x * y;
                     }
                 }
             }
-            if cholesky_in_place(&mut work.l, rows) {
-                work.lt.resize(rows * rows, 0.0);
-                for i in 0..rows {
-                    for j in 0..=i {
-                        work.lt[j * rows + i] = work.l[i * rows + j];
-                    }
-                }
+            if cholesky_upper_in_place(&mut work.lt, rows) {
                 return;
             }
         }
@@ -561,7 +560,6 @@ impl ReactionSolver {
             }
         } else {
             chunk_solve(
-                &work.l,
                 &work.lt,
                 rows,
                 &work.a,
@@ -629,9 +627,7 @@ pub struct ReactionWork {
     nz: Vec<Vec<usize>>,
     /// Orthonormal mobility basis, column-major.
     u: Vec<f64>,
-    /// Lower Cholesky factor of `AAᵀ + UUᵀ`, row-major.
-    l: Vec<f64>,
-    /// `Lᵀ`, row-major.
+    /// `Lᵀ` (upper triangular) of `AAᵀ + UUᵀ = L Lᵀ`, row-major.
     lt: Vec<f64>,
     /// `A⁺` when the fast path is off or failed.
     pinv: Option<DMatrix<f64>>,
@@ -639,44 +635,33 @@ pub struct ReactionWork {
     z: Vec<[f64; 8]>,
 }
 
-/// Dot product with eight independent accumulators (vectorises; fixed summation order).
-#[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 8];
-    let ca = a.chunks_exact(8);
-    let cb = b.chunks_exact(8);
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for p in 0..8 {
-            acc[p] += x[p] * y[p];
-        }
-    }
-    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
-    }
-    s
-}
-
 crate::simd::multiversion! {
-/// Lower Cholesky factorisation in place (row-major `n × n`, lower triangle used, upper
-/// triangle zero); false when the matrix is not numerically positive definite.
-fn cholesky_in_place(l: &mut [f64], n: usize) -> bool {
-    let max_diag = (0..n).fold(0.0f64, |m, i| m.max(l[i * n + i]));
+/// Cholesky factorisation `S = Rᵀ R` in place: `s` holds the upper triangle of `S` row-major
+/// and receives the upper triangular `R` (= `Lᵀ`; the strict lower triangle is left zero).
+/// Row `j` of `R` is updated by contiguous multiply-adds with the rows above it. False when
+/// `S` is not numerically positive definite.
+fn cholesky_upper_in_place(s: &mut [f64], n: usize) -> bool {
+    let max_diag = (0..n).fold(0.0f64, |m, i| m.max(s[i * n + i]));
     for j in 0..n {
-        let (head, tail) = l.split_at_mut((j + 1) * n);
-        let row_j = &mut head[j * n..];
-        let d = row_j[j] - dot(&row_j[..j], &row_j[..j]);
+        let (above, rest) = s.split_at_mut(j * n);
+        let row_j = &mut rest[j..n];
+        for row_k in above.chunks_exact(n) {
+            let x = row_k[j];
+            if x != 0.0 {
+                for (v, &y) in row_j.iter_mut().zip(&row_k[j..n]) {
+                    *v -= x * y;
+                }
+            }
+        }
+        let d = row_j[0];
         if d.is_nan() || d <= 1e-13 * max_diag {
             return false;
         }
         let d = d.sqrt();
-        row_j[j] = d;
         let inv = 1.0 / d;
-        let row_j = &head[j * n..j * n + j];
-        for row_i in tail.chunks_exact_mut(n) {
-            let x = row_i[j] - dot(&row_i[..j], row_j);
-            row_i[j] = x * inv;
+        row_j[0] = d;
+        for v in row_j[1..].iter_mut() {
+            *v *= inv;
         }
     }
     true
@@ -719,7 +704,6 @@ crate::simd::multiversion! {
 /// `y = Aᵀ (L Lᵀ)⁻¹ b` for `m` right-hand sides (`b` row-major `rows × m`; `y` row-major
 /// `k × m`; `lt` = `Lᵀ` row-major), eight right-hand sides at a time.
 fn chunk_solve(
-    l: &[f64],
     lt: &[f64],
     rows: usize,
     a: &[f64],
@@ -733,20 +717,28 @@ fn chunk_solve(
     z.resize(rows, [0.0; 8]);
     for c0 in (0..m).step_by(8) {
         let width = 8.min(m - c0);
-        // L z = b
-        for i in 0..rows {
-            let s = combo8(&l[i * rows..i * rows + i], &z[..i]);
-            let d = 1.0 / l[i * rows + i];
-            let mut zi = [0.0; 8];
-            for p in 0..width {
-                zi[p] = (b[i * m + c0 + p] - s[p]) * d;
+        // L z = b, column by column: z_j = b_j / L_jj, then b_i −= L_ij z_j (i > j)
+        for (i, zi) in z.iter_mut().enumerate() {
+            let mut v = [0.0; 8];
+            v[..width].copy_from_slice(&b[i * m + c0..i * m + c0 + width]);
+            *zi = v;
+        }
+        for j in 0..rows {
+            let d = 1.0 / lt[j * rows + j];
+            let mut zj = z[j];
+            for v in zj.iter_mut() {
+                *v *= d;
             }
-            z[i] = zi;
+            z[j] = zj;
+            let col = &lt[j * rows + j + 1..(j + 1) * rows];
+            for (zi, &x) in z[j + 1..].iter_mut().zip(col) {
+                axpy8(zi, -x, &zj);
+            }
         }
         // Lᵀ y = z
         for i in (0..rows).rev() {
             let s = combo8(&lt[i * rows + i + 1..(i + 1) * rows], &z[i + 1..rows]);
-            let d = 1.0 / l[i * rows + i];
+            let d = 1.0 / lt[i * rows + i];
             let mut yi = z[i];
             for p in 0..8 {
                 yi[p] = (yi[p] - s[p]) * d;
