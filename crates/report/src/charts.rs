@@ -132,12 +132,10 @@ fn torque(r: &RunResults) -> Vec<Chart> {
     r.torque_charts
         .iter()
         .map(|c| {
-            let mut title = format!("{} — task {}", c.actuator, crate::format::task(c.task));
-            if !c.critical_for.is_empty() {
-                title.push_str(&format!(" ({})", c.critical_for.join(", ")));
-            }
+            let title = format!("{} — task {}", c.actuator, crate::format::task(c.task));
             let chart = LineChart {
                 title: title.clone(),
+                subtitle: Some(critical_summary(&c.critical_for)),
                 x_label: "time [s]".into(),
                 y_label: "motor torque [N·m]".into(),
                 series: c
@@ -164,6 +162,46 @@ fn torque(r: &RunResults) -> Vec<Chart> {
         .collect()
 }
 
+/// `["CRT of UB", "CPT of UB", "CPT of SB1"]` → `"critical: CRT, CPT of UB; CPT of SB1"`:
+/// mechanisms with the same kinds are listed together, in order of first mention.
+pub fn critical_summary(reasons: &[String]) -> String {
+    let mut by_who: Vec<(String, Vec<String>)> = Vec::new();
+    for r in reasons {
+        let (kind, who) = r.split_once(" of ").unwrap_or((r.as_str(), ""));
+        match by_who.iter_mut().find(|(w, _)| w == who) {
+            Some((_, kinds)) if !kinds.iter().any(|k| k == kind) => kinds.push(kind.to_string()),
+            Some(_) => {}
+            None => by_who.push((who.to_string(), vec![kind.to_string()])),
+        }
+    }
+    let mut groups: Vec<(Vec<String>, Vec<String>)> = Vec::new();
+    for (who, kinds) in by_who {
+        match groups.iter_mut().find(|(k, _)| *k == kinds) {
+            Some((_, whos)) => whos.push(who),
+            None => groups.push((kinds, vec![who])),
+        }
+    }
+    if groups.is_empty() {
+        return String::new();
+    }
+    let parts: Vec<String> = groups
+        .iter()
+        .map(|(kinds, whos)| {
+            let whos: Vec<&str> = whos
+                .iter()
+                .map(|w| w.as_str())
+                .filter(|w| !w.is_empty())
+                .collect();
+            if whos.is_empty() {
+                kinds.join(", ")
+            } else {
+                format!("{} of {}", kinds.join(", "), whos.join(", "))
+            }
+        })
+        .collect();
+    format!("critical task: {}", parts.join("; "))
+}
+
 fn path_charts(
     r: &RunResults,
     name: &str,
@@ -184,6 +222,7 @@ fn path_charts(
             let title = format!("{kind} torque along {name} — {actuator}");
             let chart = LineChart {
                 title: title.clone(),
+                subtitle: None,
                 x_label: x_label.clone(),
                 y_label: "motor torque [N·m]".into(),
                 series: run
@@ -210,4 +249,30 @@ fn path_charts(
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn critical_reasons_are_grouped() {
+        let r = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        assert_eq!(
+            critical_summary(&r(&[
+                "CRT of UB",
+                "CPT of UB",
+                "CPT of SB73",
+                "CPT of SB1",
+                "CRT of SB57",
+                "CPT of SB57"
+            ])),
+            "critical task: CRT, CPT of UB, SB57; CPT of SB73, SB1"
+        );
+        assert_eq!(
+            critical_summary(&r(&["CRT of UB"])),
+            "critical task: CRT of UB"
+        );
+        assert_eq!(critical_summary(&[]), "");
+    }
 }

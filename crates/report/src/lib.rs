@@ -10,7 +10,8 @@
 //! Modules, one job each: [`indicators`] (Eqs. 15–21), [`ranking`] (lexicographic order at a
 //! resolution), [`results`] (the schema and `finalize`), [`tables`] (the tables both reports
 //! share), [`svg`] (hand-written charts), [`charts`] (which charts), [`html`], [`markdown`],
-//! [`csv`], [`output`] (atomic files), [`format`] (numbers and escaping).
+//! [`csv`], [`text`] (terminal summary), [`output`] (atomic files), [`format`] (numbers and
+//! escaping).
 
 pub mod charts;
 pub mod csv;
@@ -23,6 +24,7 @@ pub mod ranking;
 pub mod results;
 pub mod svg;
 pub mod tables;
+pub mod text;
 
 pub use indicators::{
     DeltaR, IndicatorError, JointReaction, JointVariation, delta_r, percent_variation,
@@ -30,8 +32,9 @@ pub use indicators::{
 pub use output::{OutputError, read_results, regenerate, write_atomic, write_outputs};
 pub use ranking::{Class, RankItem, Ranking, RankingError, RankingOptions, rank};
 pub use results::{
-    ActuatorSummary, CounterweightParams, Curve, ElementInfo, ElementKind, Evaluation,
-    FreeDirection, JointPeak, OptimiserInfo, PathMechanism, PathRun, PathSimulation, PathStat,
-    PhaseTiming, PhysicalParameters, Plane, RankingInfo, ResultsError, RunMetadata, RunResults,
-    SCHEMA_VERSION, SpringParams, StatusCount, TaskRef, TorqueChart, VariantRecord, VariantStatus,
+    ActuatorSummary, CounterweightParams, CriticalTask, Curve, ElementInfo, ElementKind,
+    Evaluation, FreeDirection, JointPeak, OptimiserInfo, PathMechanism, PathRun, PathSimulation,
+    PathStat, PhaseTiming, PhysicalParameters, Plane, RankingInfo, ResultsError, RunMetadata,
+    RunResults, SCHEMA_VERSION, SpringParams, StatusCount, TaskRef, TorqueChart, VariantRecord,
+    VariantStatus,
 };

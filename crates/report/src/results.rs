@@ -363,6 +363,18 @@ impl VariantRecord {
     }
 }
 
+/// A task on which an actuator's torque curve is worth showing (see
+/// [`RunResults::critical_tasks`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CriticalTask {
+    /// Actuator index (order of `unbalanced.actuators`, i.e. the case's).
+    pub actuator: usize,
+    pub actuator_name: String,
+    pub task: TaskRef,
+    /// e.g. `["CRT of UB", "CPT of UB", "CRT of SB1"]`; goes into [`TorqueChart::critical_for`].
+    pub critical_for: Vec<String>,
+}
+
 /// Wall time of one phase.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PhaseTiming {
@@ -619,6 +631,40 @@ impl RunResults {
                     .find(|v| v.class == c && v.class_rank == Some(1))
             })
             .collect()
+    }
+
+    /// The (actuator, task) pairs whose torque curves the report should show: the critical RMS
+    /// and peak tasks of every actuator of the unbalanced robot and of the best variant of each
+    /// class (after `finalize`), each pair once, with every reason it is critical. In actuator
+    /// order, then in order of first mention.
+    pub fn critical_tasks(&self) -> Vec<CriticalTask> {
+        let mut out: Vec<CriticalTask> = Vec::new();
+        let mut mechanisms = vec![("UB".to_string(), &self.unbalanced)];
+        for v in self.best_per_class() {
+            if let (Some(name), Some(e)) = (&v.name, &v.evaluation) {
+                mechanisms.push((name.clone(), e));
+            }
+        }
+        for (a, actuator) in self.unbalanced.actuators.iter().enumerate() {
+            for (who, eval) in &mechanisms {
+                let Some(act) = eval.actuators.get(a) else {
+                    continue;
+                };
+                for (task, kind) in [(act.crt, "CRT"), (act.cpt, "CPT")] {
+                    let why = format!("{kind} of {who}");
+                    match out.iter_mut().find(|c| c.actuator == a && c.task == task) {
+                        Some(c) => c.critical_for.push(why),
+                        None => out.push(CriticalTask {
+                            actuator: a,
+                            actuator_name: actuator.name.clone(),
+                            task,
+                            critical_for: vec![why],
+                        }),
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// Look a variant up by id.

@@ -115,6 +115,8 @@ pub struct LineSeries {
 #[derive(Clone, Debug)]
 pub struct LineChart {
     pub title: String,
+    /// A smaller second line under the title (e.g. why this task is shown).
+    pub subtitle: Option<String>,
     pub x_label: String,
     pub y_label: String,
     pub series: Vec<LineSeries>,
@@ -169,12 +171,38 @@ fn legend(items: &[(String, String, bool, bool)], x0: f64, y0: f64, width: f64) 
     (out, y - y0 + row)
 }
 
-fn svg_open(width: f64, height: f64, title: &str) -> String {
-    format!(
-        r##"<svg xmlns="http://www.w3.org/2000/svg" class="chart" viewBox="0 0 {width:.0} {height:.0}" width="{width:.0}" height="{height:.0}" role="img" aria-label="{t}"><title>{t}</title><rect x="0" y="0" width="{width:.0}" height="{height:.0}" fill="#ffffff"/><text x="{:.1}" y="20" font-size="14" font-weight="600" text-anchor="middle">{t}</text>"##,
+/// A centred line of text that never overflows the chart: when its estimated width exceeds
+/// the room, `textLength` squeezes it to fit.
+fn centred_text(out: &mut String, text: &str, width: f64, y: f64, size: f64, extra: &str) {
+    let room = width - 24.0;
+    let fit = if text_width(text, size) > room {
+        format!(r#" textLength="{room:.0}" lengthAdjust="spacingAndGlyphs""#)
+    } else {
+        String::new()
+    };
+    let _ = write!(
+        out,
+        r#"<text x="{:.1}" y="{y:.1}" font-size="{size}" text-anchor="middle"{fit}{extra}>{}</text>"#,
         width / 2.0,
+        escape_html(text)
+    );
+}
+
+/// Opens the `<svg>` with a white background, the title and an optional subtitle; returns the
+/// markup and the y where the legend starts.
+fn svg_open(width: f64, height: f64, title: &str, subtitle: Option<&str>) -> (String, f64) {
+    let mut out = format!(
+        r##"<svg xmlns="http://www.w3.org/2000/svg" class="chart" viewBox="0 0 {width:.0} {height:.0}" width="{width:.0}" height="{height:.0}" role="img" aria-label="{t}"><title>{t}</title><rect x="0" y="0" width="{width:.0}" height="{height:.0}" fill="#ffffff"/>"##,
         t = escape_html(title)
-    )
+    );
+    centred_text(&mut out, title, width, 20.0, 14.0, r#" font-weight="600""#);
+    match subtitle {
+        Some(sub) if !sub.is_empty() => {
+            centred_text(&mut out, sub, width, 37.0, SMALL, r##" fill="#555555""##);
+            (out, 58.0)
+        }
+        _ => (out, 42.0),
+    }
 }
 
 /// Axis frame, grid lines and tick labels; returns the y mapping.
@@ -230,15 +258,15 @@ pub fn line_chart(chart: &LineChart) -> String {
     let (width, height) = (chart.width, chart.height);
     let left = 70.0;
     let right = 18.0;
-    let mut out = svg_open(width, height, &chart.title);
+    let (mut out, legend_y) = svg_open(width, height, &chart.title, chart.subtitle.as_deref());
     let items: Vec<_> = chart
         .series
         .iter()
         .map(|s| (s.label.clone(), s.color.clone(), s.dashed, false))
         .collect();
-    let (legend_svg, legend_h) = legend(&items, left, 42.0, width - left - right);
+    let (legend_svg, legend_h) = legend(&items, left, legend_y, width - left - right);
     out.push_str(&legend_svg);
-    let top = 42.0 + legend_h + 4.0;
+    let top = legend_y + legend_h + 4.0;
     let bottom = 50.0;
     let (x_lo, x_hi) = {
         let (lo, hi) = range(chart.series.iter().flat_map(|s| s.x.iter().copied()), false);
@@ -298,9 +326,11 @@ pub fn line_chart(chart: &LineChart) -> String {
         height - 10.0,
         escape_html(&chart.x_label)
     );
-    // Drawn last-to-first so the first series (the reference, dashed) lies on top and stays
-    // visible where a variant's curve coincides with it.
-    for s in chart.series.iter().rev() {
+    // Drawn last-to-first, each later series a little wider, so coinciding curves (a spring-only
+    // and a hybrid variant often have identical torques) show as nested bands instead of
+    // hiding each other, and the first series (the reference, dashed) lies on top.
+    for (k, s) in chart.series.iter().enumerate().rev() {
+        let stroke = 1.8 + k.saturating_sub(1) as f64;
         let mut points = String::new();
         for (x, y) in s.x.iter().zip(&s.y) {
             if x.is_finite() && y.is_finite() {
@@ -314,7 +344,7 @@ pub fn line_chart(chart: &LineChart) -> String {
         };
         let _ = write!(
             out,
-            r#"<polyline points="{}" fill="none" stroke="{}" stroke-width="2" stroke-linejoin="round"{dash}><title>{}</title></polyline>"#,
+            r#"<polyline points="{}" fill="none" stroke="{}" stroke-width="{stroke:.1}" stroke-linejoin="round"{dash}><title>{}</title></polyline>"#,
             points.trim_end(),
             s.color,
             escape_html(&s.label)
@@ -353,15 +383,15 @@ pub fn bar_chart(chart: &BarChart) -> String {
     let right = 18.0;
     let width = (left + right + group * chart.categories.len() as f64).max(chart.min_width);
     let height = chart.height;
-    let mut out = svg_open(width, height, &chart.title);
+    let (mut out, legend_y) = svg_open(width, height, &chart.title, None);
     let items: Vec<_> = chart
         .series
         .iter()
         .map(|(l, c)| (l.clone(), c.clone(), false, true))
         .collect();
-    let (legend_svg, legend_h) = legend(&items, left, 42.0, width - left - right);
+    let (legend_svg, legend_h) = legend(&items, left, legend_y, width - left - right);
     out.push_str(&legend_svg);
-    let top = 42.0 + legend_h + 4.0;
+    let top = legend_y + legend_h + 4.0;
     let bottom = 44.0;
     let (y_lo, y_hi) = range(chart.values.iter().flatten().copied(), true);
     let plot_w = width - left - right;
@@ -462,6 +492,7 @@ mod tests {
     fn charts_escape_labels_and_are_single_svg_elements() {
         let line = line_chart(&LineChart {
             title: "M<1>".into(),
+            subtitle: Some("a very long subtitle that certainly does not fit into the width of this small chart at all".into()),
             x_label: "time [s]".into(),
             y_label: "torque [N·m]".into(),
             series: vec![LineSeries {
@@ -478,6 +509,11 @@ mod tests {
         assert!(line.starts_with("<svg") && line.ends_with("</svg>"));
         assert_eq!(line.matches("<svg").count(), 1);
         assert!(line.contains("M&lt;1&gt;") && line.contains("UB &amp; co"));
+        assert_eq!(
+            line.matches("textLength").count(),
+            1,
+            "only the long subtitle is squeezed"
+        );
         let bars = bar_chart(&BarChart {
             title: "Springs".into(),
             y_label: "%".into(),

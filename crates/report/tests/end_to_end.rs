@@ -565,3 +565,36 @@ fn full_ties_are_flagged_and_listed() {
         "{html}"
     );
 }
+
+#[test]
+fn critical_tasks_cover_ub_and_best_variants_once() {
+    let r = full();
+    let tasks = r.critical_tasks();
+    // UB: per actuator n, CRT [n, 30+n] and CPT [n+1, 20]; the best variants share them.
+    assert_eq!(tasks.len(), 6);
+    assert_eq!(tasks[0].actuator_name, "M1");
+    assert_eq!(tasks[0].task, [1, 31]);
+    assert_eq!(
+        tasks[0].critical_for,
+        ["CRT of UB", "CRT of SB4", "CRT of SB1", "CRT of SB3"]
+    );
+    let mut pairs: Vec<_> = tasks.iter().map(|t| (t.actuator, t.task)).collect();
+    pairs.dedup();
+    assert_eq!(pairs.len(), 6);
+}
+
+#[test]
+fn terminal_summary() {
+    let r = full();
+    let s = counterpoise_report::text::summary(&r);
+    assert!(s.contains("11 variants examined (Dmax = 2)"), "{s}");
+    assert!(s.contains("5 feasible, 1 discarded"), "{s}");
+    assert!(
+        s.lines()
+            .any(|l| l.trim_start().starts_with("Springs only") && l.contains("SB1")),
+        "{s}"
+    );
+    // Columns line up: every ranking row has the same length up to the last column.
+    let rows: Vec<&str> = s.lines().filter(|l| l.contains(" SB")).collect();
+    assert!(rows.len() >= 5);
+}
