@@ -55,13 +55,27 @@ enum Command {
         #[arg(long, requires = "task")]
         series: Option<PathBuf>,
     },
-    /// The whole case study: balance, optimise, rank, report (not yet available).
+    /// The whole case study: unbalanced indicators, balance search, optimisation, ranking,
+    /// reports (results.json, report.html, report.md, ranking.csv).
     Run {
         case: PathBuf,
+        /// Most elements per variant (default: the case's `balancing.dmax`).
         #[arg(long)]
         dmax: Option<usize>,
+        /// Output directory (default: out/<case name>).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Minimise QTR over all tasks (constraint generation) instead of the paper's RMS*.
+        #[arg(long)]
+        minimax: bool,
+        /// Ranking resolution in percentage points: closer values tie.
+        #[arg(long, default_value_t = 0.01)]
+        resolution: f64,
+    },
+    /// Regenerate report.html, report.md and ranking.csv from DIR/results.json.
+    Report {
+        /// A directory written by `run`.
+        dir: PathBuf,
     },
 }
 
@@ -99,13 +113,23 @@ fn main() -> ExitCode {
                 series: task.zip(series.as_deref()),
             },
         ),
-        Command::Run { .. } => {
-            eprintln!(
-                "counterpoise run: not yet available — the optimisation and report stages are \
-                 still being built. `counterpoise variants CASE` runs the balance search."
-            );
-            return ExitCode::from(2);
-        }
+        Command::Run {
+            case,
+            dmax,
+            out,
+            minimax,
+            resolution,
+        } => commands::run::run(
+            &case,
+            commands::run::Options {
+                dmax,
+                out,
+                jobs: rayon::current_num_threads(),
+                minimax,
+                resolution,
+            },
+        ),
+        Command::Report { dir } => commands::report(&dir),
     };
     match result {
         Ok(code) => code,

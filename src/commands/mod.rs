@@ -2,6 +2,7 @@
 
 pub mod check;
 pub mod evaluate;
+pub mod run;
 pub mod variants;
 
 use std::path::Path;
@@ -43,4 +44,13 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
     std::fs::rename(&tmp, path)
         .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     Ok(())
+}
+
+/// `counterpoise report DIR`: rewrites the reports from `DIR/results.json`.
+pub fn report(dir: &Path) -> Result<std::process::ExitCode> {
+    let written = counterpoise_report::regenerate(dir)?;
+    for f in written {
+        println!("wrote {}", f.display());
+    }
+    Ok(std::process::ExitCode::SUCCESS)
 }

@@ -1,0 +1,508 @@
+//! `counterpoise run CASE`: the whole case study — Phase 1 (unbalanced robot), Phase 2 (balance
+//! search, optimisation with re-evaluation over all tasks), Phase 3 (ranking, reports).
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+use anyhow::{Context as _, Result, bail};
+use counterpoise_balance::{
+    Catalogue, SearchOptions, Status, VariantResult, catalogue_options, mechanism_energy,
+    realization_hints, search,
+};
+use counterpoise_dynamics::params::ParameterSet;
+use counterpoise_dynamics::{
+    Counterweight, EvaluateOptions, Indicators, Spring, Variant, evaluate_grid, task_series_with,
+};
+use counterpoise_model::Model;
+use counterpoise_optimise::{Context, Objective, OptimiseOptions, OptimisedVariant, optimise_all};
+use counterpoise_report as report;
+use indicatif::{ProgressBar, ProgressStyle};
+use report::{
+    ActuatorSummary, ElementInfo, ElementKind, Evaluation, FreeDirection, JointPeak, OptimiserInfo,
+    PhaseTiming, PhysicalParameters, RankingOptions, RunMetadata, RunResults, VariantRecord,
+    VariantStatus,
+};
+
+/// Options of the command.
+pub struct Options {
+    pub dmax: Option<usize>,
+    pub out: Option<PathBuf>,
+    pub jobs: usize,
+    pub minimax: bool,
+    pub resolution: f64,
+}
+
+/// A spinner for one phase on stderr; indicatif hides it when stderr is not a terminal.
+fn phase(message: &str) -> ProgressBar {
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("template"));
+    bar.set_message(message.to_string());
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    bar
+}
+
+struct Timer(Vec<PhaseTiming>);
+
+impl Timer {
+    fn time<T>(&mut self, name: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
+        let bar = phase(name);
+        let started = Instant::now();
+        let out = work();
+        let seconds = started.elapsed().as_secs_f64();
+        bar.finish_and_clear();
+        self.0.push(PhaseTiming {
+            phase: name.to_string(),
+            seconds,
+        });
+        out
+    }
+}
+
+pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
+    let Some(model) = super::load(path)? else {
+        return Ok(ExitCode::FAILURE);
+    };
+    let Some(balancing) = &model.balancing else {
+        bail!("{}: the case has no `balancing` section", path.display());
+    };
+    if model.tasks.is_none() {
+        bail!("{}: the case has no `tasks` section", path.display());
+    }
+    let dmax = options.dmax.unwrap_or(balancing.dmax);
+    if dmax == 0 {
+        bail!("--dmax must be at least 1");
+    }
+    let out_dir = options
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(&model.name));
+    std::fs::create_dir_all(&out_dir)
+        .with_context(|| format!("cannot create the output directory {}", out_dir.display()))?;
+    let started = Instant::now();
+    let mut timer = Timer(Vec::new());
+
+    // Phase 1: the unbalanced robot over every task, with joint reactions.
+    let (unbalanced, ub_grid_info) =
+        timer.time("Phase 1: unbalanced robot over all tasks", || {
+            let grid = evaluate_grid(
+                &model,
+                &ParameterSet::unbalanced(&model),
+                &EvaluateOptions::default(),
+            )?;
+            let info = (
+                grid.tasks.len(),
+                grid.excluded.count,
+                grid.reactions_minimum_norm,
+            );
+            Ok((grid.indicators[0].clone(), info))
+        })?;
+
+    // Phase 2: exact balance search.
+    let found = timer.time("Phase 2: balance search", || {
+        let energy = mechanism_energy(&model);
+        let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+        if catalogue.is_empty() {
+            bail!("`balancing` allows no counterweight and no spring");
+        }
+        Ok(search(
+            &energy,
+            catalogue,
+            SearchOptions {
+                dmax,
+                hints: realization_hints(&model),
+            },
+        ))
+    })?;
+
+    // Phase 2: optimisation of every balanced variant, re-evaluated over all tasks.
+    let optimised = timer.time("Phase 2: optimisation of the balanced variants", || {
+        let context = Context::new(&model, Some(unbalanced.clone()))?;
+        let settings = OptimiseOptions {
+            objective: if options.minimax {
+                Objective::Minimax
+            } else {
+                Objective::RmsStar
+            },
+            ..OptimiseOptions::default()
+        };
+        Ok(optimise_all(&context, &found.variants, &settings))
+    })?;
+
+    // Phase 3: ranking and reports.
+    let mut results = RunResults::new(
+        RunMetadata {
+            tool: "counterpoise".into(),
+            tool_version: env!("CARGO_PKG_VERSION").into(),
+            case_name: model.name.clone(),
+            case_path: path.display().to_string(),
+            dmax,
+            jobs: options.jobs,
+            date: utc_now(),
+            timings: Vec::new(),
+            notes: Vec::new(),
+        },
+        serde_json::to_value(&model.case)?,
+        evaluation(&unbalanced, ub_grid_info),
+    );
+    if ub_grid_info.2 {
+        results.metadata.notes.push(
+            "The mechanism is overconstrained (planar loops in space): joint reactions are the \
+             minimum-norm solution."
+                .into(),
+        );
+    }
+    let mut balanced = optimised.iter();
+    for (id, v) in found.variants.iter().enumerate() {
+        let opt = (v.status == Status::Balanced).then(|| {
+            balanced
+                .next()
+                .expect("the optimiser returns one result per balanced variant")
+        });
+        results
+            .variants
+            .push(record(&model, id, v, opt, ub_grid_info));
+    }
+    timer.time("Phase 3: ranking, torque curves, path", || {
+        let ranking = RankingOptions {
+            resolution: options.resolution,
+        };
+        results.finalize(&ranking)?;
+        add_torque_charts(&model, &mut results, &optimised)?;
+        results.finalize(&ranking)?;
+        Ok(())
+    })?;
+    results.metadata.timings = timer.0;
+    results.metadata.timings.push(PhaseTiming {
+        phase: "total".into(),
+        seconds: started.elapsed().as_secs_f64(),
+    });
+    let written = report::write_outputs(&out_dir, &results)?;
+    print!("{}", summary(&results));
+    for f in written {
+        println!("wrote {}", f.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn utc_now() -> String {
+    let secs = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    // civil-from-days (Howard Hinnant's algorithm): no date crate for one timestamp
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        (rem % 3600) / 60,
+        rem % 60
+    )
+}
+
+/// Indicators in the report's schema.
+fn evaluation(
+    ind: &Indicators,
+    (tasks, excluded, minimum_norm): (usize, usize, bool),
+) -> Evaluation {
+    Evaluation {
+        qtr: ind.qtr,
+        qtr_task: ind.qtr_task,
+        qit: ind.qit,
+        qit_task: ind.qit_task,
+        actuators: ind
+            .actuators
+            .iter()
+            .map(|a| ActuatorSummary {
+                name: a.name.clone(),
+                crt: a.crt,
+                crt_rms: a.crt_rms,
+                cpt: a.cpt,
+                cpt_peak: a.cpt_peak,
+            })
+            .collect(),
+        joints: ind
+            .joints
+            .iter()
+            .map(|j| JointPeak {
+                name: j.name.clone(),
+                force: j.force,
+                force_task: Some(j.force_task),
+                moment: j.moment,
+                moment_task: Some(j.moment_task),
+            })
+            .collect(),
+        tasks: tasks - excluded,
+        excluded_tasks: excluded,
+        reactions_minimum_norm: minimum_norm,
+    }
+}
+
+fn class(c: counterpoise_balance::Class) -> report::Class {
+    match c {
+        counterpoise_balance::Class::Counterweights => report::Class::Counterweights,
+        counterpoise_balance::Class::Springs => report::Class::Springs,
+        counterpoise_balance::Class::Hybrid => report::Class::Hybrid,
+    }
+}
+
+fn plane(p: Option<counterpoise_model::Plane>) -> Option<report::Plane> {
+    p.map(|p| match p {
+        counterpoise_model::Plane::Xy => report::Plane::Xy,
+        counterpoise_model::Plane::Yz => report::Plane::Yz,
+        counterpoise_model::Plane::Xz => report::Plane::Xz,
+    })
+}
+
+/// One variant's record: the search's verdict, and the optimiser's for balanced ones.
+fn record(
+    model: &Model,
+    id: usize,
+    v: &VariantResult,
+    opt: Option<&OptimisedVariant>,
+    grid_info: (usize, usize, bool),
+) -> VariantRecord {
+    let elements = v
+        .elements
+        .iter()
+        .map(|e| ElementInfo {
+            label: e.label.clone(),
+            kind: if e.kind == "spring" {
+                ElementKind::Spring
+            } else {
+                ElementKind::Counterweight
+            },
+            bodies: e.bodies.clone(),
+        })
+        .collect();
+    let status = match v.status {
+        Status::Balanced => VariantStatus::Feasible,
+        Status::Degenerate => VariantStatus::Degenerate,
+        Status::Unrealizable => VariantStatus::Unrealizable,
+        Status::Infeasible => VariantStatus::Infeasible,
+        Status::Undecided => VariantStatus::Undecided,
+    };
+    let mut r = VariantRecord::new(id, elements, class(v.class), status);
+    r.reason = v.reason.clone();
+    r.relations = v.relations.clone();
+    r.free_directions = v
+        .free_directions
+        .iter()
+        .map(|f| FreeDirection {
+            components: f.components.clone(),
+            positive_interval: f.positive_interval,
+        })
+        .collect();
+    r.verification_residual = v.verification.map(|x| x.residual);
+    let Some(opt) = opt else {
+        return r;
+    };
+    r.optimiser = Some(OptimiserInfo {
+        objective: opt.objective,
+        lower_bound: opt.lower_bound,
+        gap: opt.gap,
+        iterations: Some(opt.iterations.len()),
+        message: opt.reason.clone(),
+    });
+    let balancing = model.balancing.as_ref();
+    let cw_plane = plane(
+        balancing
+            .and_then(|b| b.counterweights.as_ref())
+            .and_then(|c| c.plane),
+    );
+    let spring_plane = plane(
+        balancing
+            .and_then(|b| b.springs.as_ref())
+            .and_then(|s| s.plane),
+    );
+    r.parameters = Some(PhysicalParameters {
+        counterweights: opt
+            .counterweights
+            .iter()
+            .map(|c| report::CounterweightParams {
+                label: c.label.clone(),
+                body: c.body.clone(),
+                mass: c.mass,
+                offset: c.offset,
+                plane: cw_plane,
+            })
+            .collect(),
+        springs: opt
+            .springs
+            .iter()
+            .map(|s| report::SpringParams {
+                label: s.label.clone(),
+                body: s.body.clone(),
+                other: s.other.clone(),
+                stiffness: s.stiffness,
+                anchor_a: s.anchor_a,
+                anchor_b: s.anchor_b,
+                plane: spring_plane,
+            })
+            .collect(),
+    });
+    match (opt.is_feasible(), &opt.indicators) {
+        (true, Some(ind)) => {
+            r.status = VariantStatus::Feasible;
+            r.evaluation = Some(evaluation(ind, grid_info));
+            if let Some(res) = opt.residual {
+                r.verification_residual = Some(res);
+            }
+        }
+        (true, None) => {
+            r.status = VariantStatus::Discarded;
+            r.reason = Some("optimised, but not re-evaluated over all tasks".into());
+        }
+        (false, _) => {
+            r.status = VariantStatus::Discarded;
+            r.reason = opt.reason.clone();
+        }
+    }
+    r
+}
+
+/// The dynamics crate's description of a variant's elements.
+fn dynamics_variant(model: &Model, opt: &OptimisedVariant) -> Result<Variant> {
+    let body = |name: &str| {
+        model
+            .body_index(name)
+            .with_context(|| format!("optimiser named an unknown body `{name}`"))
+    };
+    let mut v = Variant::default();
+    for c in &opt.counterweights {
+        v.counterweights.push(Counterweight {
+            body: body(&c.body)?,
+            mass: c.mass,
+            position: c.offset,
+        });
+    }
+    for s in &opt.springs {
+        v.springs.push(Spring {
+            body: body(&s.body)?,
+            other: if s.other == "base" {
+                None
+            } else {
+                Some(body(&s.other)?)
+            },
+            stiffness: s.stiffness,
+            anchor: s.anchor_a,
+            other_anchor: s.anchor_b,
+        });
+    }
+    Ok(v)
+}
+
+/// Torque curves (paper Fig. 10-style) of the unbalanced robot and the best variant of each
+/// class, on the critical RMS and peak tasks of the unbalanced robot.
+fn add_torque_charts(
+    model: &Model,
+    results: &mut RunResults,
+    optimised: &[OptimisedVariant],
+) -> Result<()> {
+    let best: Vec<(usize, String)> = results
+        .best_per_class()
+        .iter()
+        .map(|v| (v.id, v.display_name()))
+        .collect();
+    let mut variants = vec![Variant::default()];
+    let mut labels = vec![("UB".to_string(), None)];
+    for (id, name) in &best {
+        let label = results.variant(*id).map(|v| v.label()).unwrap_or_default();
+        let Some(opt) = optimised.iter().find(|o| o.elements.join(" + ") == label) else {
+            continue;
+        };
+        variants.push(dynamics_variant(model, opt)?);
+        labels.push((name.clone(), Some(*id)));
+    }
+    let params = ParameterSet::from_variants(model, &variants)?;
+    let mut tasks: Vec<([usize; 2], Vec<String>)> = Vec::new();
+    for a in &results.unbalanced.actuators {
+        for (task, why) in [
+            (a.crt, format!("CRT of {} (UB)", a.name)),
+            (a.cpt, format!("CPT of {} (UB)", a.name)),
+        ] {
+            match tasks.iter_mut().find(|(t, _)| *t == task) {
+                Some((_, reasons)) => reasons.push(why),
+                None => tasks.push((task, vec![why])),
+            }
+        }
+    }
+    results.torque_charts.clear();
+    for (task, why) in tasks {
+        let series: Vec<_> = (0..variants.len())
+            .map(|c| task_series_with(model, &params, c, task[0], task[1], None))
+            .collect::<Result<_, _>>()?;
+        for (k, actuator) in model.actuators.iter().enumerate() {
+            results.torque_charts.push(report::TorqueChart {
+                actuator: actuator.name.clone(),
+                task,
+                critical_for: why.clone(),
+                t: series[0].t.clone(),
+                curves: series
+                    .iter()
+                    .zip(&labels)
+                    .map(|(s, (label, variant))| report::Curve {
+                        label: label.clone(),
+                        variant: *variant,
+                        values: s.motor_torque.iter().map(|row| row[k]).collect(),
+                    })
+                    .collect(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The final table on stdout: counts per status and the ranking.
+fn summary(r: &RunResults) -> String {
+    let mut out = format!(
+        "{}: Dmax {}, {} variants examined\n",
+        r.metadata.case_name,
+        r.metadata.dmax,
+        r.variants.len()
+    );
+    for c in &r.counts {
+        out.push_str(&format!(
+            "  {:<13} {:>6}   (counterweights {}, springs {}, hybrid {})\n",
+            c.status.name(),
+            c.total,
+            c.counterweights,
+            c.springs,
+            c.hybrid
+        ));
+    }
+    out.push_str(&format!(
+        "\nunbalanced: QTR {:.3} N·m, QIT {:.3} N·m\n\n",
+        r.unbalanced.qtr, r.unbalanced.qit
+    ));
+    out.push_str(&format!(
+        "{:>5} {:>6}  {:<24} {:<15} {:>9} {:>9} {:>8}\n",
+        "rank", "class", "variant", "class", "ΔQTR %", "ΔQIT %", "ΔR %"
+    ));
+    for v in r.ranked().iter().take(25) {
+        out.push_str(&format!(
+            "{:>5} {:>6}  {:<24} {:<15} {:>9.2} {:>9.2} {:>8.2}\n",
+            v.rank.unwrap_or(0),
+            v.class_rank.unwrap_or(0),
+            v.label(),
+            v.class.name(),
+            v.dqtr.unwrap_or(f64::NAN),
+            v.dqit.unwrap_or(f64::NAN),
+            v.dr.unwrap_or(f64::NAN)
+        ));
+    }
+    let total = r.metadata.timings.iter().find(|t| t.phase == "total");
+    if let Some(t) = total {
+        out.push_str(&format!("\ntotal {:.2} s\n", t.seconds));
+    }
+    out
+}
