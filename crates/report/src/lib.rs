@@ -7,6 +7,39 @@
 //! (results.json, report.html, report.md, ranking.csv, each written atomically).
 //! `counterpoise report DIR` calls [`regenerate`].
 //!
+//! ```
+//! use counterpoise_report::*;
+//!
+//! let metadata = RunMetadata {
+//!     tool: "counterpoise".into(), tool_version: "0.1.0".into(),
+//!     case_name: "pendulum".into(), case_path: "cases/pendulum.json".into(),
+//!     dmax: 1, jobs: 2, date: "2026-11-22T00:00:00Z".into(),
+//!     timings: vec![PhaseTiming { phase: "search".into(), seconds: 0.01 }], notes: vec![],
+//! };
+//! let eval = |qtr: f64| Evaluation {
+//!     qtr, qtr_task: [0, 1], qit: 2.0 * qtr, qit_task: [0, 1], actuators: vec![],
+//!     joints: vec![JointPeak { name: "J1".into(), force: 100.0, force_task: None,
+//!                              moment: 10.0 * qtr, moment_task: None }],
+//!     tasks: 1, excluded_tasks: 0, reactions_minimum_norm: false,
+//! };
+//! let mut results = RunResults::new(metadata, serde_json::json!({}), eval(10.0));
+//! let element = ElementInfo { label: "m1".into(), kind: ElementKind::Counterweight,
+//!                             bodies: vec!["arm".into()] };
+//! let mut v = VariantRecord::new(0, vec![element], Class::Counterweights, VariantStatus::Feasible);
+//! v.evaluation = Some(eval(4.0));
+//! results.variants.push(v);
+//! results.finalize(&RankingOptions::default())?;        // ΔQTR = −60 %, rank 1
+//! assert_eq!(results.variants[0].dqtr, Some(-60.0));
+//! // Torque curves: for each `results.critical_tasks()`, compute the series of UB and of
+//! // `results.best_per_class()`, push a `TorqueChart`, then `finalize` again (idempotent).
+//! let dir = std::env::temp_dir().join(format!("cp-report-doc-{}", std::process::id()));
+//! write_outputs(&dir, &results)?;                        // results.json, report.html, …
+//! print!("{}", text::summary(&results));                  // the run command's stdout table
+//! regenerate(&dir)?;                                      // `counterpoise report DIR`
+//! # std::fs::remove_dir_all(&dir).ok();
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! Modules, one job each: [`indicators`] (Eqs. 15–21), [`ranking`] (lexicographic order at a
 //! resolution), [`results`] (the schema and `finalize`), [`tables`] (the tables both reports
 //! share), [`svg`] (hand-written charts), [`charts`] (which charts), [`html`], [`markdown`],
