@@ -275,7 +275,8 @@ impl ConicProblem {
             })
             .collect();
         let mut settings = DefaultSettings {
-            verbose: false,
+            // Diagnostics only: COUNTERPOISE_CLARABEL_VERBOSE=1 prints clarabel's log.
+            verbose: std::env::var_os("COUNTERPOISE_CLARABEL_VERBOSE").is_some(),
             max_iter,
             ..DefaultSettings::default()
         };

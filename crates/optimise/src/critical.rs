@@ -25,8 +25,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::context::Context;
 use crate::problem::{CwPhysical, Objective, VariantProblem};
-use crate::refine::{counterweight_directions, merit, project_fixed, refine};
-use crate::relaxation::solve_relaxation;
+use crate::refine::{
+    FEASIBILITY_TOL, counterweight_directions, merit, project_fixed, project_radius, refine,
+};
+use crate::relaxation::{solve_bounds_only, solve_relaxation};
 use crate::result::{
     FreeParameter, Iteration, OptimisedCounterweight, OptimisedSpring, OptimisedStatus,
     OptimisedVariant,
@@ -57,7 +59,7 @@ impl Default for OptimiseOptions {
             objective: Objective::RmsStar,
             max_iterations: 8,
             gap_tolerance: 1e-3,
-            spring_starts: 4,
+            spring_starts: 8,
             final_reactions: true,
             solver_iterations: 200,
         }
@@ -295,16 +297,27 @@ fn step(
         ));
     }
     if status != crate::clarabel_map::ConicStatus::Solved {
+        // Often a nearly infeasible problem: the bounds alone may prove it.
+        let bounds_only = solve_bounds_only(problem, options.solver_iterations);
+        if bounds_only.is_infeasible() {
+            return Err(format!(
+                "the bounds cannot all be met: the convex relaxation of the bounds alone is                  infeasible (clarabel: {}; with the objective and peak limits: {})",
+                bounds_only.name(),
+                status.name()
+            ));
+        }
         return Err(format!(
             "the relaxation was not solved (clarabel: {})",
             status.name()
         ));
     }
     let lower = relaxed.bound;
-    let z_relaxed = project_fixed(problem, &relaxed.z);
+    let dirs = counterweight_directions(problem);
+    let z_fixed = project_fixed(problem, &relaxed.z);
+    let z_relaxed = project_radius(problem, &z_fixed, &dirs).unwrap_or(z_fixed);
     let scale = lower.abs().max(1e-9);
     let (_, v0, viol0) = merit(problem, &tasks, options.objective, &z_relaxed, scale);
-    let gap_before = if viol0 <= 0.0 && v0.is_finite() {
+    let gap_before = if viol0 <= FEASIBILITY_TOL && v0.is_finite() {
         ((v0 - lower) / v0.max(1e-300)).max(0.0)
     } else {
         f64::INFINITY
@@ -312,7 +325,6 @@ fn step(
     let z = if gap_before <= options.gap_tolerance {
         z_relaxed
     } else {
-        let dirs = counterweight_directions(problem);
         let refined = refine(problem, &tasks, options.objective, &z_relaxed, &dirs, scale);
         if !refined.feasible {
             return Err(format!(
@@ -324,13 +336,22 @@ fn step(
         refined.z
     };
     let x = problem.lifted(&z);
-    let (springs, note) = realize_springs(
+    let (mut springs, mut note) = realize_springs(
         problem,
         &ctx.basis.unbalanced,
         &x,
         options.spring_starts,
         false,
     );
+    if springs.is_empty() && !problem.springs.is_empty() {
+        (springs, note) = realize_springs(
+            problem,
+            &ctx.basis.unbalanced,
+            &x,
+            options.spring_starts * 4,
+            false,
+        );
+    }
     let (springs, x_full) = match springs.into_iter().next() {
         Some(found) => found,
         None if !problem.counterweights.is_empty() => {
@@ -339,7 +360,7 @@ fn step(
                 problem,
                 &ctx.basis.unbalanced,
                 &x,
-                options.spring_starts,
+                options.spring_starts * 4,
                 true,
             );
             joint.into_iter().next().ok_or(note)?

@@ -135,6 +135,69 @@ pub fn counterweight_directions(problem: &VariantProblem) -> DMatrix<f64> {
     }
 }
 
+/// Relative constraint violation treated as none (rounding of exact equalities).
+pub const FEASIBILITY_TOL: f64 = 1e-12;
+
+/// Counterweights whose distance is fixed (`radius: [r, r]`), with `r`.
+fn radius_equalities(problem: &VariantProblem) -> Vec<(usize, f64)> {
+    problem
+        .counterweights
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.bounds.radius[0] == c.bounds.radius[1] && !c.axes.is_empty())
+        .map(|(k, c)| (k, c.bounds.radius[0]))
+        .collect()
+}
+
+/// The point near `z` with every fixed distance met exactly, `|μ_c| = r_c·m_c`, by
+/// Gauss–Newton minimum-norm steps along `directions` (which keep the fixed masses). A
+/// non-linear equality cannot be met by a simplex search, so the refinement works on this
+/// projection instead. `None` when the projection does not converge.
+pub fn project_radius(
+    problem: &VariantProblem,
+    z: &DVector<f64>,
+    directions: &DMatrix<f64>,
+) -> Option<DVector<f64>> {
+    let eqs = radius_equalities(problem);
+    if eqs.is_empty() {
+        return Some(z.clone());
+    }
+    if directions.ncols() == 0 {
+        return None;
+    }
+    let nd = &problem.nullspace * directions;
+    let mut z = z.clone();
+    for _ in 0..30 {
+        let x = problem.lifted(&z);
+        let mut g = DVector::zeros(eqs.len());
+        let mut jac = DMatrix::zeros(eqs.len(), directions.ncols());
+        let mut worst = 0.0f64;
+        for (i, &(k, r)) in eqs.iter().enumerate() {
+            let c = &problem.counterweights[k];
+            let mu: Vec<f64> = (0..c.axes.len()).map(|a| x[c.column + 1 + a]).collect();
+            let len = crate::problem::norm(&mu);
+            if len <= 0.0 {
+                return None;
+            }
+            g[i] = len - r * x[c.column];
+            worst = worst.max(g[i].abs() / (r * c.bounds.mass[1]).max(1e-300));
+            for d in 0..directions.ncols() {
+                let mut v = -r * nd[(c.column, d)];
+                for (a, m) in mu.iter().enumerate() {
+                    v += m / len * nd[(c.column + 1 + a, d)];
+                }
+                jac[(i, d)] = v;
+            }
+        }
+        if worst <= 1e-14 {
+            return Some(z);
+        }
+        let step = jac.svd(true, true).solve(&g, 1e-12).ok()?;
+        z -= directions * step;
+    }
+    None
+}
+
 /// Objective plus penalty at `z`, with feasibility.
 pub fn merit(
     problem: &VariantProblem,
@@ -169,10 +232,10 @@ pub fn refine(
     scale: f64,
 ) -> Refined {
     let n = directions.ncols();
-    let at = |y: &DVector<f64>| z0 + directions * y;
+    let at = |y: &DVector<f64>| project_radius(problem, &(z0 + directions * y), directions);
     let (_, v0, viol0) = merit(problem, tasks, objective, z0, scale);
     let mut best_feasible: Option<(DVector<f64>, f64, f64)> =
-        (viol0 <= 0.0).then(|| (z0.clone(), v0, viol0));
+        (viol0 <= FEASIBILITY_TOL).then(|| (z0.clone(), v0, viol0));
     let mut best_any = (z0.clone(), v0, viol0);
     let mut evaluations = 1;
     if n == 0 {
@@ -180,12 +243,14 @@ pub fn refine(
     }
     let mut f = |y: &DVector<f64>, evals: &mut usize| {
         *evals += 1;
-        let z = at(y);
+        let Some(z) = at(y) else {
+            return f64::INFINITY;
+        };
         let (m, v, viol) = merit(problem, tasks, objective, &z, scale);
-        if viol <= 0.0 && best_feasible.as_ref().is_none_or(|b| v < b.1) {
+        if viol <= FEASIBILITY_TOL && best_feasible.as_ref().is_none_or(|b| v < b.1) {
             best_feasible = Some((z.clone(), v, viol));
         }
-        if viol < best_any.2 || (viol <= 0.0 && v < best_any.1) {
+        if viol < best_any.2 || (viol <= FEASIBILITY_TOL && v < best_any.1) {
             best_any = (z, v, viol);
         }
         m

@@ -14,7 +14,7 @@
 //! - `|r| ≥ r_lo`, `|a| ≥ a_lo`, `|b| ≥ b_lo` and spring realizability (`K·W = αβᵀ`) are dropped.
 //!
 //! The bounds that are convex in the lifted variables are kept exactly: masses, `|μ| ≤ r_hi·m`,
-//! stiffnesses, `|K a| ≤ a_hi·K`, `|K b| ≤ b_hi·K`; the peak limits are linear inequalities at
+//! stiffnesses, `|K a| ≤ a_hi·K`, `|K b| ≤ b_hi·K`, `|K a_k b_l| ≤ a_hi·b_hi·K`; the peak limits are linear inequalities at
 //! every working-set sample. The objective is RMS* (`min ‖t‖/√N`, `t_n ≥` the RMS of actuator
 //! `n` on each working-set task) or, for minimax, `min u`, `u ≥ Σ_n RMS_{n,w}` per task.
 //!
@@ -30,6 +30,10 @@ use nalgebra::DVector;
 use crate::clarabel_map::{Affine, ConicProblem, ConicSolution};
 use crate::problem::{Objective, VariantProblem};
 use crate::torque::TaskTorques;
+
+/// Relative margin taken off the relaxation's value: clarabel meets its optimality conditions
+/// to about 1e-8, so the dual value may exceed the exact optimum by that much.
+pub const BOUND_MARGIN: f64 = 1e-7;
 
 /// Result of the relaxation.
 #[derive(Clone, Debug)]
@@ -272,6 +276,18 @@ pub fn solve_relaxation(
             let b_scale = natural[s.column + 1 + na] / big_k;
             cp.soc(&k.scaled(s.bounds.anchor_b[1] / b_scale), &beta);
         }
+        // |W_kl| = K·|a_k b_l| ≤ K·a_hi·b_hi: keeps the coupling terms bounded.
+        for i in 0..na * nb {
+            let w = xn(s.column + 1 + na + nb + i);
+            let w_scale = natural[s.column + 1 + na + nb + i] / big_k;
+            let bound = s.bounds.anchor_a[1] * s.bounds.anchor_b[1] / w_scale;
+            let mut up = k.scaled(bound);
+            up.add_scaled(&w, -1.0);
+            cp.nonneg(&up);
+            let mut down = k.scaled(bound);
+            down.add_scaled(&w, 1.0);
+            cp.nonneg(&down);
+        }
     }
 
     // Torque expressions per task, sample, actuator, divided by a torque scale.
@@ -299,6 +315,10 @@ pub fn solve_relaxation(
 
     let u = cp.new_variable();
     cp.objective[u] = 1.0;
+    if tasks.is_empty() {
+        // Bounds only: keep the problem bounded (with tasks, the cones already do).
+        cp.nonneg(&Affine::var(u));
+    }
     match objective {
         Objective::RmsStar => {
             let t: Vec<usize> = (0..na).map(|_| cp.new_variable()).collect();
@@ -354,8 +374,19 @@ pub fn solve_relaxation(
     let solution = cp.solve(max_iter);
     let zv = DVector::from_iterator(d, z.iter().zip(&dz).map(|(&j, &s)| solution.x[j] * s));
     Relaxed {
-        bound: tau_scale * solution.objective.min(solution.dual_objective),
+        bound: tau_scale * solution.objective.min(solution.dual_objective) * (1.0 - BOUND_MARGIN),
         z: zv,
         solution,
     }
+}
+
+/// The relaxation of the bounds alone (no tasks, no objective): its infeasibility proves that no
+/// parameters within the bounds balance the variant.
+pub fn solve_bounds_only(
+    problem: &VariantProblem,
+    max_iter: u32,
+) -> crate::clarabel_map::ConicStatus {
+    solve_relaxation(problem, &[], Objective::Minimax, max_iter)
+        .solution
+        .status
 }
