@@ -330,7 +330,7 @@ pub fn line_chart(chart: &LineChart) -> String {
     // and a hybrid variant often have identical torques) show as nested bands instead of
     // hiding each other, and the first series (the reference, dashed) lies on top.
     for (k, s) in chart.series.iter().enumerate().rev() {
-        let stroke = 1.8 + k.saturating_sub(1) as f64;
+        let stroke = 1.8 + 0.7 * k.saturating_sub(1) as f64;
         let mut points = String::new();
         for (x, y) in s.x.iter().zip(&s.y) {
             if x.is_finite() && y.is_finite() {
