@@ -79,7 +79,6 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
         .unwrap_or_else(|| PathBuf::from("out").join(&model.name));
     std::fs::create_dir_all(&out_dir)
         .with_context(|| format!("cannot create the output directory {}", out_dir.display()))?;
-    let started = Instant::now();
     let mut timer = Timer(Vec::new());
 
     // Phase 1: the unbalanced robot over every task, with joint reactions.
@@ -168,17 +167,17 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
             resolution: options.resolution,
         };
         results.finalize(&ranking)?;
-        add_torque_charts(&model, &mut results, &optimised)?;
+        let mechanisms = best_mechanisms(&model, &results, &optimised)?;
+        add_torque_charts(&model, &mut results, &mechanisms)?;
+        if !model.paths.is_empty() {
+            results.path = Some(path_simulation(&model, &mechanisms, 0)?);
+        }
         results.finalize(&ranking)?;
         Ok(())
     })?;
     results.metadata.timings = timer.0;
-    results.metadata.timings.push(PhaseTiming {
-        phase: "total".into(),
-        seconds: started.elapsed().as_secs_f64(),
-    });
     let written = report::write_outputs(&out_dir, &results)?;
-    print!("{}", summary(&results));
+    print!("{}", report::text::summary(&results));
     for f in written {
         println!("wrote {}", f.display());
     }
@@ -401,108 +400,144 @@ fn dynamics_variant(model: &Model, opt: &OptimisedVariant) -> Result<Variant> {
     Ok(v)
 }
 
-/// Torque curves (paper Fig. 10-style) of the unbalanced robot and the best variant of each
-/// class, on the critical RMS and peak tasks of the unbalanced robot.
-fn add_torque_charts(
+/// The unbalanced robot and the best variant of each class as parameter columns, with their
+/// labels (`UB`, then display names) and variant ids.
+struct Mechanisms {
+    params: ParameterSet,
+    labels: Vec<(String, Option<usize>)>,
+}
+
+fn best_mechanisms(
     model: &Model,
-    results: &mut RunResults,
+    results: &RunResults,
     optimised: &[OptimisedVariant],
-) -> Result<()> {
-    let best: Vec<(usize, String)> = results
-        .best_per_class()
-        .iter()
-        .map(|v| (v.id, v.display_name()))
-        .collect();
+) -> Result<Mechanisms> {
     let mut variants = vec![Variant::default()];
     let mut labels = vec![("UB".to_string(), None)];
-    for (id, name) in &best {
-        let label = results.variant(*id).map(|v| v.label()).unwrap_or_default();
+    for v in results.best_per_class() {
+        let label = v.label();
         let Some(opt) = optimised.iter().find(|o| o.elements.join(" + ") == label) else {
             continue;
         };
         variants.push(dynamics_variant(model, opt)?);
-        labels.push((name.clone(), Some(*id)));
+        labels.push((v.display_name(), Some(v.id)));
     }
-    let params = ParameterSet::from_variants(model, &variants)?;
-    let mut tasks: Vec<([usize; 2], Vec<String>)> = Vec::new();
-    for a in &results.unbalanced.actuators {
-        for (task, why) in [
-            (a.crt, format!("CRT of {} (UB)", a.name)),
-            (a.cpt, format!("CPT of {} (UB)", a.name)),
-        ] {
-            match tasks.iter_mut().find(|(t, _)| *t == task) {
-                Some((_, reasons)) => reasons.push(why),
-                None => tasks.push((task, vec![why])),
-            }
-        }
-    }
-    results.torque_charts.clear();
-    for (task, why) in tasks {
-        let series: Vec<_> = (0..variants.len())
-            .map(|c| task_series_with(model, &params, c, task[0], task[1], None))
-            .collect::<Result<_, _>>()?;
-        for (k, actuator) in model.actuators.iter().enumerate() {
-            results.torque_charts.push(report::TorqueChart {
-                actuator: actuator.name.clone(),
-                task,
-                critical_for: why.clone(),
-                t: series[0].t.clone(),
-                curves: series
-                    .iter()
-                    .zip(&labels)
-                    .map(|(s, (label, variant))| report::Curve {
-                        label: label.clone(),
-                        variant: *variant,
-                        values: s.motor_torque.iter().map(|row| row[k]).collect(),
-                    })
-                    .collect(),
-            });
-        }
-    }
-    Ok(())
+    Ok(Mechanisms {
+        params: ParameterSet::from_variants(model, &variants)?,
+        labels,
+    })
 }
 
-/// The final table on stdout: counts per status and the ranking.
-fn summary(r: &RunResults) -> String {
-    let mut out = format!(
-        "{}: Dmax {}, {} variants examined\n",
-        r.metadata.case_name,
-        r.metadata.dmax,
-        r.variants.len()
-    );
-    for c in &r.counts {
-        out.push_str(&format!(
-            "  {:<13} {:>6}   (counterweights {}, springs {}, hybrid {})\n",
-            c.status.name(),
-            c.total,
-            c.counterweights,
-            c.springs,
-            c.hybrid
-        ));
+/// Samples per path segment in the path simulation.
+const PATH_SAMPLES_PER_SEGMENT: usize = 60;
+/// How much the quasi-static run stretches the path's durations: velocities scale by 1e-6 and
+/// the inertial torques by 1e-12, far below anything a report shows.
+const STATIC_STRETCH: f64 = 1e6;
+
+/// The paper's Sec. 3.3 simulation along path `index`: the timed cycle, and the same path
+/// traversed quasi-statically (static torques).
+fn path_simulation(model: &Model, m: &Mechanisms, index: usize) -> Result<report::PathSimulation> {
+    let spec = &model.paths[index];
+    let actuators: Vec<String> = model.actuators.iter().map(|a| a.name.clone()).collect();
+    let run_of = |model: &Model, time_scale: f64| -> Result<report::PathRun> {
+        let mut x = Vec::new();
+        let mut mechanisms = Vec::new();
+        for (column, (label, variant)) in m.labels.iter().enumerate() {
+            let series = counterpoise_dynamics::path_series(
+                model,
+                &m.params,
+                column,
+                index,
+                PATH_SAMPLES_PER_SEGMENT,
+            )?;
+            if x.is_empty() {
+                x = series.t.iter().map(|t| t / time_scale).collect();
+            }
+            let torques = (0..actuators.len())
+                .map(|k| series.motor_torque.iter().map(|row| row[k]).collect())
+                .collect();
+            mechanisms.push(report::PathMechanism {
+                label: label.clone(),
+                variant: *variant,
+                torques,
+            });
+        }
+        Ok(report::PathRun {
+            x_label: "time".into(),
+            x_unit: "s".into(),
+            x,
+            mechanisms,
+        })
+    };
+    let dynamic_run = run_of(model, 1.0)?;
+    let mut slow = model.clone();
+    for d in &mut slow.paths[index].durations {
+        *d *= STATIC_STRETCH;
     }
-    out.push_str(&format!(
-        "\nunbalanced: QTR {:.3} N·m, QIT {:.3} N·m\n\n",
-        r.unbalanced.qtr, r.unbalanced.qit
-    ));
-    out.push_str(&format!(
-        "{:>5} {:>6}  {:<24} {:<15} {:>9} {:>9} {:>8}\n",
-        "rank", "class", "variant", "class", "ΔQTR %", "ΔQIT %", "ΔR %"
-    ));
-    for v in r.ranked().iter().take(25) {
-        out.push_str(&format!(
-            "{:>5} {:>6}  {:<24} {:<15} {:>9.2} {:>9.2} {:>8.2}\n",
-            v.rank.unwrap_or(0),
-            v.class_rank.unwrap_or(0),
-            v.label(),
-            v.class.name(),
-            v.dqtr.unwrap_or(f64::NAN),
-            v.dqit.unwrap_or(f64::NAN),
-            v.dr.unwrap_or(f64::NAN)
-        ));
+    let static_run = run_of(&slow, STATIC_STRETCH)?;
+    let name = |k: usize| spec.waypoints[spec.sequence[k]].name.clone();
+    let waypoints = (0..spec.sequence.len())
+        .map(name)
+        .collect::<Vec<_>>()
+        .join("-");
+    let payload = spec
+        .payload
+        .as_ref()
+        .map(|p| {
+            format!(
+                ", {} kg payload picked at {} and dropped at {}",
+                p.mass,
+                name(p.pick_at),
+                name(p.drop_at)
+            )
+        })
+        .unwrap_or_default();
+    Ok(report::PathSimulation {
+        name: spec.name.clone(),
+        description: Some(format!(
+            "{waypoints} in {:.2} s{payload}; static torques from the same path traversed \
+             {STATIC_STRETCH:e} times slower",
+            spec.durations.iter().sum::<f64>()
+        )),
+        actuators,
+        static_run: Some(static_run),
+        dynamic_run: Some(dynamic_run),
+        table: Vec::new(),
+    })
+}
+
+/// Torque curves (paper Fig. 10-style) of the unbalanced robot and the best variant of each
+/// class, on the critical RMS and peak tasks of each of them.
+fn add_torque_charts(model: &Model, results: &mut RunResults, m: &Mechanisms) -> Result<()> {
+    let (params, labels) = (&m.params, &m.labels);
+    let columns = labels.len();
+    let critical = results.critical_tasks();
+    let mut cache: Vec<([usize; 2], Vec<counterpoise_dynamics::Series>)> = Vec::new();
+    let mut charts = Vec::new();
+    for c in critical {
+        if !cache.iter().any(|(t, _)| *t == c.task) {
+            let series = (0..columns)
+                .map(|col| task_series_with(model, params, col, c.task[0], c.task[1], None))
+                .collect::<Result<Vec<_>, _>>()?;
+            cache.push((c.task, series));
+        }
+        let series = &cache.iter().find(|(t, _)| *t == c.task).expect("cached").1;
+        charts.push(report::TorqueChart {
+            actuator: c.actuator_name.clone(),
+            task: c.task,
+            critical_for: c.critical_for.clone(),
+            t: series[0].t.clone(),
+            curves: series
+                .iter()
+                .zip(labels)
+                .map(|(s, (label, variant))| report::Curve {
+                    label: label.clone(),
+                    variant: *variant,
+                    values: s.motor_torque.iter().map(|row| row[c.actuator]).collect(),
+                })
+                .collect(),
+        });
     }
-    let total = r.metadata.timings.iter().find(|t| t.phase == "total");
-    if let Some(t) = total {
-        out.push_str(&format!("\ntotal {:.2} s\n", t.seconds));
-    }
-    out
+    results.torque_charts = charts;
+    Ok(())
 }
