@@ -24,12 +24,13 @@ use rayon::prelude::*;
 
 use crate::error::{FailureReason, TaskFailure};
 use crate::indicators::{StatsAccumulator, StatsTable, TaskStats};
-use crate::kernel::{actuator_forces, required_wrenches};
+use crate::kernel::{actuator_forces, required_wrenches_with};
 use crate::law::{quintic, quintic_move, sample_time};
 use crate::lu::SmallLu;
 use crate::mechanism::{BodyKin, Scratch};
 use crate::params::ParameterSet;
 use crate::reactions::ReactionWork;
+use crate::regressor::{WrenchRegressor, wrench_regressor};
 use crate::runner::Evaluator;
 use crate::symmetry::Cyclic;
 use crate::tasks::TaskSet;
@@ -45,6 +46,7 @@ struct SubTaskData {
 struct Work {
     scratch: Scratch,
     kin: Vec<BodyKin>,
+    regressors: Vec<WrenchRegressor>,
     reactions: ReactionWork,
     w: Vec<f64>,
     b: Vec<f64>,
@@ -366,11 +368,13 @@ fn sub_task(
                 qdd[a] -= bias[a];
             }
             lu.solve(&mut qdd);
+            work.regressors.clear();
             for (b, kin) in work.kin.iter_mut().enumerate() {
                 mech.set_motion(&pose, b, kin, &qd, &qdd);
+                work.regressors.push(wrench_regressor(kin, &mech.gravity));
             }
             for p in 0..cols {
-                required_wrenches(mech, &pose, &work.kin, params, p, &mut work.w);
+                required_wrenches_with(mech, &pose, &work.regressors, params, p, &mut work.w);
                 let qu = actuator_forces(&work.kin, &work.w, n, &lu);
                 let st = &mut work.states[(si * cols + p) * block..(si * cols + p + 1) * block];
                 for a in 0..n {

@@ -11,7 +11,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::lu::SmallLu;
 use crate::mechanism::{BodyKin, Mechanism};
 use crate::params::{BODY_PARAMS, ParameterSet, SPRING_PARAMS};
-use crate::regressor::spring_wrenches;
+use crate::regressor::{WrenchRegressor, spring_wrenches};
 
 /// Symmetric inertia from `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]`.
 #[inline]
@@ -55,6 +55,46 @@ pub fn required_wrenches(
         );
         w[6 * i..6 * i + 3].copy_from_slice(f.as_slice());
         w[6 * i + 3..6 * i + 6].copy_from_slice(n.as_slice());
+    }
+    for (s, slot) in params.springs.iter().enumerate() {
+        let off = BODY_PARAMS * l + SPRING_PARAMS * s;
+        let x = &col[off..off + SPRING_PARAMS];
+        if x.iter().all(|&v| v == 0.0) {
+            continue;
+        }
+        let (fi, ni, fs, ns) = spring_wrenches(mech, pose, slot, x);
+        for r in 0..3 {
+            w[6 * slot.body + r] -= fi[r];
+            w[6 * slot.body + 3 + r] -= ni[r];
+            if let Some(o) = slot.other {
+                w[6 * o + r] -= fs[r];
+                w[6 * o + 3 + r] -= ns[r];
+            }
+        }
+    }
+}
+
+/// Like [`required_wrenches`] from precomputed wrench regressors of the bodies (cheaper when
+/// many columns share one motion): `w_i = W_i π_i` minus spring forces.
+pub fn required_wrenches_with(
+    mech: &Mechanism,
+    pose: &[f64],
+    regressors: &[WrenchRegressor],
+    params: &ParameterSet,
+    column: usize,
+    w: &mut [f64],
+) {
+    let col = params.column(column);
+    let l = regressors.len();
+    for (i, reg) in regressors.iter().enumerate() {
+        let pi = &col[BODY_PARAMS * i..BODY_PARAMS * (i + 1)];
+        for r in 0..6 {
+            let mut acc = 0.0;
+            for c in 0..BODY_PARAMS {
+                acc += reg[r][c] * pi[c];
+            }
+            w[6 * i + r] = acc;
+        }
     }
     for (s, slot) in params.springs.iter().enumerate() {
         let off = BODY_PARAMS * l + SPRING_PARAMS * s;

@@ -632,7 +632,7 @@ pub struct ReactionWork {
     /// `A⁺` when the fast path is off or failed.
     pinv: Option<DMatrix<f64>>,
     y: Vec<f64>,
-    z: Vec<[f64; 8]>,
+    z: SolveScratch,
 }
 
 crate::simd::multiversion! {
@@ -668,41 +668,48 @@ fn cholesky_upper_in_place(s: &mut [f64], n: usize) -> bool {
 }
 }
 
-/// `acc += x · v` on eight lanes.
+/// `acc += x · v` on `W` lanes.
 #[inline(always)]
-fn axpy8(acc: &mut [f64; 8], x: f64, v: &[f64; 8]) {
-    for p in 0..8 {
+fn axpy<const W: usize>(acc: &mut [f64; W], x: f64, v: &[f64; W]) {
+    for p in 0..W {
         acc[p] += x * v[p];
     }
 }
 
-/// `Σ_j w[j] · v[j]` over eight lanes with four interleaved partial sums (independent
+/// `Σ_j w[j] · v[j]` over `W` lanes with four interleaved partial sums (independent
 /// dependency chains; fixed order).
 #[inline(always)]
-fn combo8(w: &[f64], v: &[[f64; 8]]) -> [f64; 8] {
-    let mut s = [[0.0; 8]; 4];
+fn combo<const W: usize>(w: &[f64], v: &[[f64; W]]) -> [f64; W] {
+    let mut s = [[0.0; W]; 4];
     let chunks = w.chunks_exact(4);
     let rem = chunks.remainder();
     for (wc, vc) in chunks.zip(v.chunks_exact(4)) {
-        axpy8(&mut s[0], wc[0], &vc[0]);
-        axpy8(&mut s[1], wc[1], &vc[1]);
-        axpy8(&mut s[2], wc[2], &vc[2]);
-        axpy8(&mut s[3], wc[3], &vc[3]);
+        axpy(&mut s[0], wc[0], &vc[0]);
+        axpy(&mut s[1], wc[1], &vc[1]);
+        axpy(&mut s[2], wc[2], &vc[2]);
+        axpy(&mut s[3], wc[3], &vc[3]);
     }
     let tail = w.len() - rem.len();
     for (k, &x) in rem.iter().enumerate() {
-        axpy8(&mut s[k], x, &v[tail + k]);
+        axpy(&mut s[k], x, &v[tail + k]);
     }
-    let mut out = [0.0; 8];
-    for p in 0..8 {
+    let mut out = [0.0; W];
+    for p in 0..W {
         out[p] = (s[0][p] + s[1][p]) + (s[2][p] + s[3][p]);
     }
     out
 }
 
+/// Scratch of [`chunk_solve`]: one row of lanes per equation.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SolveScratch {
+    z8: Vec<[f64; 8]>,
+}
+
 crate::simd::multiversion! {
 /// `y = Aᵀ (L Lᵀ)⁻¹ b` for `m` right-hand sides (`b` row-major `rows × m`; `y` row-major
-/// `k × m`; `lt` = `Lᵀ` row-major), eight right-hand sides at a time.
+/// `k × m`; `lt` = `Lᵀ` row-major), eight right-hand sides at a time (sixteen measured
+/// slower: the wider accumulators spill).
 fn chunk_solve(
     lt: &[f64],
     rows: usize,
@@ -712,50 +719,66 @@ fn chunk_solve(
     b: &[f64],
     m: usize,
     y: &mut [f64],
-    z: &mut Vec<[f64; 8]>,
+    z: &mut SolveScratch,
 ) {
-    z.resize(rows, [0.0; 8]);
+    z.z8.resize(rows, [0.0; 8]);
     for c0 in (0..m).step_by(8) {
-        let width = 8.min(m - c0);
-        // L z = b, column by column: z_j = b_j / L_jj, then b_i −= L_ij z_j (i > j)
-        for (i, zi) in z.iter_mut().enumerate() {
-            let mut v = [0.0; 8];
-            v[..width].copy_from_slice(&b[i * m + c0..i * m + c0 + width]);
-            *zi = v;
-        }
-        for j in 0..rows {
-            let d = 1.0 / lt[j * rows + j];
-            let mut zj = z[j];
-            for v in zj.iter_mut() {
-                *v *= d;
-            }
-            z[j] = zj;
-            let col = &lt[j * rows + j + 1..(j + 1) * rows];
-            for (zi, &x) in z[j + 1..].iter_mut().zip(col) {
-                axpy8(zi, -x, &zj);
-            }
-        }
-        // Lᵀ y = z
-        for i in (0..rows).rev() {
-            let s = combo8(&lt[i * rows + i + 1..(i + 1) * rows], &z[i + 1..rows]);
-            let d = 1.0 / lt[i * rows + i];
-            let mut yi = z[i];
-            for p in 0..8 {
-                yi[p] = (yi[p] - s[p]) * d;
-            }
-            z[i] = yi;
-        }
-        // λ = Aᵀ y
-        for c in 0..k {
-            let col = &a[c * rows..(c + 1) * rows];
-            let mut acc = [0.0; 8];
-            for &r in &nz[c] {
-                axpy8(&mut acc, col[r], &z[r]);
-            }
-            y[c * m + c0..c * m + c0 + width].copy_from_slice(&acc[..width]);
-        }
+        solve_lanes::<8>(lt, rows, a, nz, k, b, m, c0, y, &mut z.z8);
     }
 }
+}
+
+#[inline(always)]
+fn solve_lanes<const W: usize>(
+    lt: &[f64],
+    rows: usize,
+    a: &[f64],
+    nz: &[Vec<usize>],
+    k: usize,
+    b: &[f64],
+    m: usize,
+    c0: usize,
+    y: &mut [f64],
+    z: &mut [[f64; W]],
+) {
+    let width = W.min(m - c0);
+    // L z = b, column by column: z_j = b_j / L_jj, then b_i −= L_ij z_j (i > j)
+    for (i, zi) in z.iter_mut().enumerate() {
+        let mut v = [0.0; W];
+        v[..width].copy_from_slice(&b[i * m + c0..i * m + c0 + width]);
+        *zi = v;
+    }
+    for j in 0..rows {
+        let d = 1.0 / lt[j * rows + j];
+        let mut zj = z[j];
+        for v in zj.iter_mut() {
+            *v *= d;
+        }
+        z[j] = zj;
+        let col = &lt[j * rows + j + 1..(j + 1) * rows];
+        for (zi, &x) in z[j + 1..].iter_mut().zip(col) {
+            axpy(zi, -x, &zj);
+        }
+    }
+    // Lᵀ y = z
+    for i in (0..rows).rev() {
+        let s = combo(&lt[i * rows + i + 1..(i + 1) * rows], &z[i + 1..rows]);
+        let d = 1.0 / lt[i * rows + i];
+        let mut yi = z[i];
+        for p in 0..W {
+            yi[p] = (yi[p] - s[p]) * d;
+        }
+        z[i] = yi;
+    }
+    // λ = Aᵀ y
+    for c in 0..k {
+        let col = &a[c * rows..(c + 1) * rows];
+        let mut acc = [0.0; W];
+        for &r in &nz[c] {
+            axpy(&mut acc, col[r], &z[r]);
+        }
+        y[c * m + c0..c * m + c0 + width].copy_from_slice(&acc[..width]);
+    }
 }
 
 /// Orthonormal basis of the body velocity Jacobian `[J_v; J_ω]` (`6L × n`), modified
