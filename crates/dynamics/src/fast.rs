@@ -24,7 +24,7 @@ use rayon::prelude::*;
 
 use crate::error::{FailureReason, TaskFailure};
 use crate::indicators::{StatsAccumulator, StatsTable, TaskStats};
-use crate::kernel::{actuator_forces, required_wrenches_with};
+use crate::kernel::{actuator_forces, required_wrenches, required_wrenches_with};
 use crate::law::{quintic, quintic_move, sample_time};
 use crate::lu::SmallLu;
 use crate::mechanism::{BodyKin, Scratch};
@@ -368,13 +368,22 @@ fn sub_task(
                 qdd[a] -= bias[a];
             }
             lu.solve(&mut qdd);
+            // With several columns, one wrench regressor per body serves them all; with one,
+            // the direct Newton–Euler wrench is cheaper.
+            let shared = cols > 2;
             work.regressors.clear();
             for (b, kin) in work.kin.iter_mut().enumerate() {
                 mech.set_motion(&pose, b, kin, &qd, &qdd);
-                work.regressors.push(wrench_regressor(kin, &mech.gravity));
+                if shared {
+                    work.regressors.push(wrench_regressor(kin, &mech.gravity));
+                }
             }
             for p in 0..cols {
-                required_wrenches_with(mech, &pose, &work.regressors, params, p, &mut work.w);
+                if shared {
+                    required_wrenches_with(mech, &pose, &work.regressors, params, p, &mut work.w);
+                } else {
+                    required_wrenches(mech, &pose, &work.kin, params, p, &mut work.w);
+                }
                 let qu = actuator_forces(&work.kin, &work.w, n, &lu);
                 let st = &mut work.states[(si * cols + p) * block..(si * cols + p + 1) * block];
                 for a in 0..n {
