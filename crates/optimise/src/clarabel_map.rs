@@ -156,7 +156,12 @@ pub struct ConicSolution {
     pub iterations: u32,
     /// Solver runs (1 unless retried).
     pub attempts: u32,
+    /// The optimality and feasibility tolerance of the run that produced this solution.
+    pub tolerance: f64,
 }
+
+/// Solver runs at most (see [`ConicProblem::solve`]).
+const ATTEMPTS: u32 = 4;
 
 impl ConicProblem {
     pub fn new_variable(&mut self) -> usize {
@@ -219,11 +224,12 @@ impl ConicProblem {
 
     /// Solves with clarabel (quiet, deterministic); when clarabel stops short of `Solved`
     /// without proving infeasibility, retries with more iterations and a more cautious step,
-    /// then with a stronger regularization and more equilibration — the first `Solved` wins,
-    /// otherwise the last status is returned.
+    /// then with a stronger regularization and more equilibration and optimality tolerances
+    /// of 1e-7, then 1e-6 (recorded in [`ConicSolution::tolerance`]) — the first `Solved`
+    /// wins, otherwise the last status is returned.
     pub fn solve(&self, max_iter: u32) -> ConicSolution {
         let mut last = self.solve_attempt(max_iter, 0);
-        for attempt in 1..3 {
+        for attempt in 1..ATTEMPTS {
             if last.status == ConicStatus::Solved
                 || last.status.is_infeasible()
                 || last.status == ConicStatus::SetupFailed
@@ -286,6 +292,10 @@ impl ConicProblem {
             settings.equilibrate_max_iter = 50;
         }
         if attempt >= 2 {
+            let tol: f64 = if attempt >= 3 { 1e-6 } else { 1e-7 };
+            settings.tol_gap_abs = tol;
+            settings.tol_gap_rel = tol;
+            settings.tol_feas = tol;
             settings.static_regularization_constant = 1e-7;
             settings.iterative_refinement_max_iter = 50;
             settings.equilibrate_min_scaling = 1e-6;
@@ -298,7 +308,9 @@ impl ConicProblem {
             dual_objective: f64::NAN,
             iterations: 0,
             attempts: 1,
+            tolerance: f64::NAN,
         };
+        let settings_tol = settings.tol_gap_rel;
         let Ok(mut solver) =
             DefaultSolver::new(&p, &self.objective, &a, &self.rhs, &cones, settings)
         else {
@@ -313,6 +325,7 @@ impl ConicProblem {
             dual_objective: s.obj_val_dual,
             iterations: s.iterations,
             attempts: 1,
+            tolerance: settings_tol,
         }
     }
 }

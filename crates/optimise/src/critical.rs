@@ -301,7 +301,7 @@ fn step(
         let bounds_only = solve_bounds_only(problem, options.solver_iterations);
         if bounds_only.is_infeasible() {
             return Err(format!(
-                "the bounds cannot all be met: the convex relaxation of the bounds alone is                  infeasible (clarabel: {}; with the objective and peak limits: {})",
+                "the bounds cannot all be met: the convex relaxation of the bounds alone is infeasible (clarabel: {}; with the objective and peak limits: {})",
                 bounds_only.name(),
                 status.name()
             ));
@@ -363,7 +363,19 @@ fn step(
                 options.spring_starts * 4,
                 true,
             );
-            joint.into_iter().next().ok_or(note)?
+            // Of the admissible sets found, the best one that meets the peak limits on the
+            // working set (or the one closest to meeting them).
+            joint
+                .into_iter()
+                .map(|(s, xj)| {
+                    let e = problem.evaluate(&problem.cw_physical(&xj), &tasks);
+                    let excess = problem.peak_excess(&e).max(0.0);
+                    let value = e.objective(options.objective, problem.actuators);
+                    (excess, value, s, xj)
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)))
+                .map(|(_, _, s, xj)| (s, xj))
+                .ok_or(note)?
         }
         None => return Err(note),
     };

@@ -32,7 +32,8 @@ use crate::problem::{Objective, VariantProblem};
 use crate::torque::TaskTorques;
 
 /// Relative margin taken off the relaxation's value: clarabel meets its optimality conditions
-/// to about 1e-8, so the dual value may exceed the exact optimum by that much.
+/// to its tolerance (1e-8 by default), so the dual value may exceed the exact optimum by about
+/// that much; the margin is the larger of this and ten times the tolerance of the run.
 pub const BOUND_MARGIN: f64 = 1e-7;
 
 /// Result of the relaxation.
@@ -374,7 +375,9 @@ pub fn solve_relaxation(
     let solution = cp.solve(max_iter);
     let zv = DVector::from_iterator(d, z.iter().zip(&dz).map(|(&j, &s)| solution.x[j] * s));
     Relaxed {
-        bound: tau_scale * solution.objective.min(solution.dual_objective) * (1.0 - BOUND_MARGIN),
+        bound: tau_scale
+            * solution.objective.min(solution.dual_objective)
+            * (1.0 - BOUND_MARGIN.max(10.0 * solution.tolerance)),
         z: zv,
         solution,
     }

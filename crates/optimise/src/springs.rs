@@ -286,7 +286,13 @@ fn levenberg_marquardt(
     let (mut r, mut jac, mut bal, mut hinge) = residual(problem, b, x, lay, &y, pull);
     let mut cost = r.norm();
     let mut lambda = 1e-3;
+    let mut slow = 0;
     for _ in 0..300 {
+        // A start creeping along (less than 0.1 % per step for 25 steps) is heading for a
+        // solution outside the bounds or at infinity: give it up.
+        if slow >= 25 {
+            break;
+        }
         if pull.is_none() && bal <= SOLVED_TOL && hinge <= BOUND_TOL {
             break;
         }
@@ -321,6 +327,7 @@ fn levenberg_marquardt(
                 cost = c2;
                 lambda = (lambda / 3.0).max(1e-15);
                 improved = gain > 1e-15;
+                slow = if gain < 1e-3 { slow + 1 } else { 0 };
                 break;
             }
             lambda *= 4.0;

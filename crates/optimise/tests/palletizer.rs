@@ -61,6 +61,18 @@ fn the_papers_eleven_sets() {
                 assert!(check.bound_excess <= 1e-9);
                 assert!(!v.iterations.is_empty());
                 assert!(v.lower_bound.unwrap() <= v.objective.unwrap() * (1.0 + 1e-9));
+                for fp in &v.free_parameters {
+                    eprintln!(
+                        "    free {:?}: {} in {:?}",
+                        fp.components, fp.value, fp.interval
+                    );
+                    let tol = 1e-9 * fp.value.abs().max(1.0);
+                    assert!(fp.interval[0] - tol <= fp.value && fp.value <= fp.interval[1] + tol);
+                }
+                if !v.springs.is_empty() {
+                    assert!(v.delta_r_estimate.is_some(), "springs are chosen by ΔR");
+                    assert!(!v.indicators.as_ref().unwrap().joints.is_empty());
+                }
             }
             OptimisedStatus::Discarded => {
                 assert!(v.reason.as_ref().is_some_and(|r| !r.is_empty()));
