@@ -9,7 +9,7 @@ use counterpoise_balance::{
     Attachment, Catalogue, Class, SearchOptions, SearchReport, Status, VariantResult,
     catalogue_options, mechanism_energy, realization_hints, search,
 };
-use counterpoise_model::Model;
+use counterpoise_model::{Model, Plane};
 use serde_json::json;
 
 /// Version of the `variants --json` schema (documented in README.md).
@@ -85,27 +85,22 @@ pub fn to_json(
     })
 }
 
-fn angle(u: f64, v: f64) -> f64 {
-    let a = v.atan2(u);
-    if a < -1e-12 {
-        a + std::f64::consts::TAU
-    } else {
-        a.max(0.0)
-    }
-}
-
-fn polar(v: [f64; 3]) -> (f64, f64) {
-    // magnitude and angle in the plane of the two largest components' axes (the element's plane
-    // when the case restricts it; x–y otherwise)
-    let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let (u, w) = if v[2].abs() <= 1e-15 {
-        (v[0], v[1])
-    } else if v[0].abs() <= 1e-15 {
-        (v[1], v[2])
-    } else {
-        (v[0], v[2])
-    };
-    (norm, angle(u, w))
+/// Magnitude of a body-frame vector and its angle, in `[0, 2π)`, in the element's plane (the
+/// case's `plane`, x–y when unrestricted).
+fn polar(v: [f64; 3], plane: Option<Plane>) -> (f64, f64) {
+    let axes = plane.map_or((0, 1), |p| (p.axes()[0], p.axes()[1]));
+    let (_, angle) = counterpoise_report::format::polar(v, axes);
+    let angle = angle.rem_euclid(std::f64::consts::TAU);
+    let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    // −0 and rounding just below 2π print as 0
+    (
+        norm,
+        if std::f64::consts::TAU - angle < 1e-12 {
+            0.0
+        } else {
+            angle
+        },
+    )
 }
 
 /// Witness parameters in the units of the paper's Table 1: kg, mm, N/mm, rad.
@@ -120,8 +115,15 @@ pub fn witness_lines(model: &Model, v: &VariantResult) -> Vec<String> {
             .find(|e| e.entry == entry)
             .map_or("?", |e| e.label.as_str())
     };
+    let balancing = model.balancing.as_ref();
+    let cw_plane = balancing
+        .and_then(|b| b.counterweights.as_ref())
+        .and_then(|c| c.plane);
+    let spring_plane = balancing
+        .and_then(|b| b.springs.as_ref())
+        .and_then(|c| c.plane);
     for cw in &w.counterweights {
-        let (r, phi) = polar(cw.offset);
+        let (r, phi) = polar(cw.offset, cw_plane);
         lines.push(format!(
             "{:<5} m = {:.3} kg, r = {:.1} mm, φ = {:.4} rad   (on {})",
             label(cw.entry),
@@ -132,8 +134,8 @@ pub fn witness_lines(model: &Model, v: &VariantResult) -> Vec<String> {
         ));
     }
     for s in &w.springs {
-        let (a, alpha) = polar(s.anchor_a);
-        let (b, beta) = polar(s.anchor_b);
+        let (a, alpha) = polar(s.anchor_a, spring_plane);
+        let (b, beta) = polar(s.anchor_b, spring_plane);
         let other = match s.other {
             Attachment::Base => "base".to_string(),
             Attachment::Body(i) => model.bodies[i].name.clone(),
