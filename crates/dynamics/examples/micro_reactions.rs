@@ -25,12 +25,12 @@ fn main() {
     mech.actuator_map(&q, &mut scratch, &mut u, &mut g);
     let lu = SmallLu::new(&g, mech.n);
     let mut work = ReactionWork::default();
-    let reps = 20_000;
+    let reps = 500;
     for m in [3usize, 39] {
         let mut best_prep = f64::INFINITY;
         let mut best_solve = f64::INFINITY;
         let mut out = vec![0.0; 66 * m];
-        for _ in 0..5 {
+        for _ in 0..200 {
             let t = Instant::now();
             for _ in 0..reps {
                 ev.reactions.prepare(mech, &pose, &kin, &lu, &mut work);

@@ -188,7 +188,10 @@ pub fn evaluate_grid(
     };
     let names = ev.actuator_names();
     let joint_names = ev.joint_names();
+    // Each column's reduction is sequential over tasks (deterministic ties); columns are
+    // independent and run in parallel.
     let indicators = (0..params.len())
+        .into_par_iter()
         .map(|c| reduce(&table, c, &names, &joint_names, |w| tasks.pair(w)))
         .collect();
     Ok(GridEvaluation {

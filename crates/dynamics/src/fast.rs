@@ -23,7 +23,7 @@ use counterpoise_symbolic::MAX_VARS;
 use rayon::prelude::*;
 
 use crate::error::{FailureReason, TaskFailure};
-use crate::indicators::{StatsAccumulator, StatsTable, TaskStats};
+use crate::indicators::StatsTable;
 use crate::kernel::{actuator_forces, required_wrenches, required_wrenches_with};
 use crate::law::{quintic, quintic_move, sample_time};
 use crate::lu::SmallLu;
@@ -35,13 +35,6 @@ use crate::runner::Evaluator;
 use crate::symmetry::Cyclic;
 use crate::tasks::TaskSet;
 
-/// Coefficients of one sub-task: per sample, per power of `Δ` (3), per column, the motor
-/// torques (`n`) and, with reactions, the joint wrenches (`6J`).
-struct SubTaskData {
-    stride: usize,
-    values: Vec<f64>,
-}
-
 #[derive(Default)]
 struct Work {
     scratch: Scratch,
@@ -51,12 +44,38 @@ struct Work {
     w: Vec<f64>,
     b: Vec<f64>,
     out: Vec<f64>,
-    states: Vec<f64>,
+    /// Motor torques at `Δ ∈ {0, 1, −1}`: `[Δ][actuator][column]`.
+    torques: Vec<f64>,
+    /// Coefficients of the current sub-task, per sample (`stride` values): the motor torques
+    /// as quadratics in `Δ` — three arrays `[actuator][column]` — then, with reactions,
+    /// `|F_j|²` and `|M_j|²` as quartics — five arrays `[force/moment][joint][column]`.
+    /// Columns run innermost so that every task evaluation is a contiguous, vectorisable
+    /// sweep. Reused from sub-task to sub-task (every value is overwritten).
+    coefficients: Vec<f64>,
 }
 
 /// Outcome of one sub-task: the statistics of its distinct tasks and, per task, which one
 /// it is; or the failure of the sub-task.
-type SubTaskOutcome = Result<(Vec<Vec<TaskStats>>, Vec<(usize, usize)>), Vec<TaskFailure>>;
+type SubTaskOutcome = Result<(TaskRows, Vec<(usize, usize)>), Vec<TaskFailure>>;
+
+/// Statistics rows of the distinct tasks of one sub-task: per task, per column, one row in
+/// the layout of [`StatsTable`].
+struct TaskRows {
+    width: usize,
+    cols: usize,
+    data: Vec<f64>,
+}
+
+impl TaskRows {
+    fn len(&self) -> usize {
+        self.data.len() / (self.width * self.cols).max(1)
+    }
+
+    fn task(&self, t: usize) -> &[f64] {
+        let n = self.width * self.cols;
+        &self.data[t * n..(t + 1) * n]
+    }
+}
 
 /// Runs the grid through the cyclic decomposition into `table`; returns the failures in task
 /// order and the number of distinct moves evaluated.
@@ -178,8 +197,8 @@ pub(crate) fn evaluate_cyclic(
                     work,
                 ),
             };
-            let d = match data {
-                Ok(d) => d,
+            match data {
+                Ok(()) => {}
                 Err((k, reason)) => {
                     return Err(users[st]
                         .iter()
@@ -194,7 +213,7 @@ pub(crate) fn evaluate_cyclic(
                         })
                         .collect());
                 }
-            };
+            }
             // Tasks whose Δ agree to 1e-12 of the cyclic span share one evaluation (grid
             // differences such as θ(3) − θ(1) and θ(4) − θ(2) differ in the last bits); the
             // first task of a group (lowest index) provides its Δ.
@@ -210,17 +229,25 @@ pub(crate) fn evaluate_cyclic(
                     })
                 })
                 .collect();
-            let stats = task_stats(&d, &unique, ns, params.len(), na, nj);
-            Ok((stats, users[st].iter().map(|u| u.0).zip(slot).collect()))
+            let rows = task_stats(
+                &work.coefficients,
+                per_sample_stride,
+                &unique,
+                ns,
+                params.len(),
+                na,
+                nj,
+            );
+            Ok((rows, users[st].iter().map(|u| u.0).zip(slot).collect()))
         })
         .collect();
     let mut distinct = 0;
     for outcome in computed {
         match outcome {
-            Ok((stats, assignment)) => {
-                distinct += stats.len();
+            Ok((rows, assignment)) => {
+                distinct += rows.len();
                 for (w, u) in assignment {
-                    table.set(w, &stats[u]);
+                    table.set_rows(w, rows.task(u));
                 }
             }
             Err(f) => failures.extend(f),
@@ -232,72 +259,99 @@ pub(crate) fn evaluate_cyclic(
 
 crate::simd::multiversion! {
 /// Statistics of every `(reversed, Δ)` task of one sub-task. Samples run in the outer loop
-/// so that a sample's coefficients are read from cache once for all the tasks.
+/// so that a sample's coefficients are read from cache once for all the tasks; within a task
+/// every step is a contiguous sweep over `[actuator or joint][column]`.
 fn task_stats(
-    d: &SubTaskData,
+    coefficients: &[f64],
+    stride: usize,
     tasks: &[(bool, f64)],
     ns: usize,
     cols: usize,
     na: usize,
     nj: usize,
-) -> Vec<Vec<TaskStats>> {
-    let block = 3 * na + 10 * nj;
+) -> TaskRows {
     let nt = tasks.len();
-    let mut acc = vec![StatsAccumulator::new(na, nj); cols * nt];
-    // peaks of |F|², |M|² per task, column and joint (square roots taken once at the end)
-    let mut f2max = vec![0.0f64; nt * cols * nj];
-    let mut m2max = vec![0.0f64; nt * cols * nj];
-    let mut tau = [0.0; MAX_VARS];
+    let tq = na * cols;
+    let rq = 2 * nj * cols;
+    let mut sum_sq = vec![0.0f64; nt * tq];
+    let mut peak = vec![0.0f64; nt * tq];
+    let mut total_peak = vec![0.0f64; nt * cols];
+    // peaks of |F|², |M|² (square roots taken once at the end)
+    let mut reaction_peak = vec![0.0f64; nt * rq];
+    let mut tau = vec![0.0f64; tq];
+    let mut abs_sum = vec![0.0f64; cols];
     for k in 0..ns {
         for (t, &(rev, delta)) in tasks.iter().enumerate() {
             let dd = if rev { -delta } else { delta };
             let d2 = dd * dd;
             let kk = if rev { ns - 1 - k } else { k };
-            let base = &d.values[kk * d.stride..(kk + 1) * d.stride];
-            for p in 0..cols {
-                let x = &base[p * block..(p + 1) * block];
-                for a in 0..na {
-                    tau[a] = x[a] + dd * x[na + a] + d2 * x[2 * na + a];
+            let base = &coefficients[kk * stride..(kk + 1) * stride];
+            let (t0, rest) = base.split_at(tq);
+            let (t1, rest) = rest.split_at(tq);
+            let (t2, rest) = rest.split_at(tq);
+            for (i, v) in tau.iter_mut().enumerate() {
+                *v = t0[i] + dd * t1[i] + d2 * t2[i];
+            }
+            let ss = &mut sum_sq[t * tq..(t + 1) * tq];
+            let pk = &mut peak[t * tq..(t + 1) * tq];
+            for i in 0..tq {
+                ss[i] += tau[i] * tau[i];
+                let x = tau[i].abs();
+                if x > pk[i] {
+                    pk[i] = x;
                 }
-                acc[t * cols + p].add_torques(&tau[..na]);
-                if nj > 0 {
-                    let off = (t * cols + p) * nj;
-                    for (q, peaks) in [(&x[3 * na..3 * na + 5 * nj], &mut f2max), (&x[3 * na + 5 * nj..], &mut m2max)] {
-                        let (c0, rest) = q.split_at(nj);
-                        let (c1, rest) = rest.split_at(nj);
-                        let (c2, rest) = rest.split_at(nj);
-                        let (c3, c4) = rest.split_at(nj);
-                        let pk = &mut peaks[off..off + nj];
-                        for j in 0..nj {
-                            let v = (((c4[j] * dd + c3[j]) * dd + c2[j]) * dd + c1[j]) * dd + c0[j];
-                            pk[j] = pk[j].max(v);
-                        }
+            }
+            abs_sum.fill(0.0);
+            for row in tau.chunks_exact(cols) {
+                for (s, x) in abs_sum.iter_mut().zip(row) {
+                    *s += x.abs();
+                }
+            }
+            for (m, &s) in total_peak[t * cols..(t + 1) * cols].iter_mut().zip(&abs_sum) {
+                if s > *m {
+                    *m = s;
+                }
+            }
+            if nj > 0 {
+                let (c0, rest) = rest.split_at(rq);
+                let (c1, rest) = rest.split_at(rq);
+                let (c2, rest) = rest.split_at(rq);
+                let (c3, c4) = rest.split_at(rq);
+                let pk = &mut reaction_peak[t * rq..(t + 1) * rq];
+                for i in 0..rq {
+                    let v = (((c4[i] * dd + c3[i]) * dd + c2[i]) * dd + c1[i]) * dd + c0[i];
+                    if v > pk[i] {
+                        pk[i] = v;
                     }
                 }
             }
         }
     }
-    (0..nt)
-        .map(|t| {
-            (0..cols)
-                .map(|p| {
-                    let a = &mut acc[t * cols + p];
-                    let off = (t * cols + p) * nj;
-                    if nj > 0 {
-                        a.add_reactions(
-                            f2max[off..off + nj].iter().map(|v| v.max(0.0).sqrt()),
-                            m2max[off..off + nj].iter().map(|v| v.max(0.0).sqrt()),
-                        );
-                    }
-                    a.finish(nj > 0)
-                })
-                .collect()
-        })
-        .collect()
+    let width = 2 * na + 1 + 2 * nj;
+    let n = ns.max(1) as f64;
+    let mut data = vec![0.0; nt * cols * width];
+    for t in 0..nt {
+        for p in 0..cols {
+            let row = &mut data[(t * cols + p) * width..(t * cols + p + 1) * width];
+            for a in 0..na {
+                row[a] = (sum_sq[t * tq + a * cols + p] / n).sqrt();
+                row[na + a] = peak[t * tq + a * cols + p];
+            }
+            row[2 * na] = total_peak[t * cols + p];
+            for part in 0..2 {
+                for j in 0..nj {
+                    let v = reaction_peak[t * rq + (part * nj + j) * cols + p];
+                    row[2 * na + 1 + part * nj + j] = v.max(0.0).sqrt();
+                }
+            }
+        }
+    }
+    TaskRows { width, cols, data }
 }
 }
 
-/// Evaluates one sub-task at `Δ ∈ {0, 1, −1}` per sample and stores the coefficients.
+/// Evaluates one sub-task at `Δ ∈ {0, 1, −1}` per sample and stores the coefficients in
+/// `work.coefficients`.
 #[allow(clippy::too_many_arguments)]
 fn sub_task(
     ev: &Evaluator,
@@ -311,7 +365,7 @@ fn sub_task(
     with_reactions: bool,
     stride: usize,
     work: &mut Work,
-) -> Result<SubTaskData, (usize, FailureReason)> {
+) -> Result<(), (usize, FailureReason)> {
     let mech = &ev.mech;
     let n = mech.n;
     let l = mech.body_count;
@@ -321,9 +375,11 @@ fn sub_task(
     } else {
         0
     };
-    let block = n + 6 * nj;
     let rows = 6 * l;
-    let mut values = vec![0.0; ns * stride];
+    let m = 3 * cols;
+    let tq = n * cols;
+    let rq = 2 * nj * cols;
+    work.coefficients.resize(ns * stride, 0.0);
     let mut q = q0.to_vec();
     let mut u = [0.0; MAX_VARS];
     let mut ud = [0.0; MAX_VARS];
@@ -331,10 +387,10 @@ fn sub_task(
     let mut f = [0.0; MAX_VARS];
     let mut g = [0.0; MAX_VARS * MAX_VARS];
     work.w.resize(rows, 0.0);
-    work.states.resize(3 * cols * block, 0.0);
+    work.torques.resize(3 * tq, 0.0);
     if with_reactions {
-        work.b.resize(rows * 3 * cols, 0.0);
-        work.out.resize(6 * nj * 3 * cols, 0.0);
+        work.b.resize(rows * m, 0.0);
+        work.out.resize(6 * nj * m, 0.0);
     }
     for k in 0..ns {
         let t = sample_time(k, ns, duration);
@@ -385,17 +441,12 @@ fn sub_task(
                     required_wrenches(mech, &pose, &work.kin, params, p, &mut work.w);
                 }
                 let qu = actuator_forces(&work.kin, &work.w, n, &lu);
-                let st = &mut work.states[(si * cols + p) * block..(si * cols + p + 1) * block];
                 for a in 0..n {
-                    if !qu[a].is_finite() {
-                        return Err((k, FailureReason::NonFinite));
-                    }
-                    st[a] = qu[a] * ev.ratios[a];
+                    work.torques[(si * n + a) * cols + p] = qu[a] * ev.ratios[a];
                 }
                 if with_reactions {
                     ev.reactions
                         .subtract_actuators(&work.reactions, &work.kin, &qu, &mut work.w);
-                    let m = 3 * cols;
                     let col = si * cols + p;
                     for r in 0..rows {
                         work.b[r * m + col] = work.w[r];
@@ -404,61 +455,66 @@ fn sub_task(
             }
         }
         if with_reactions {
-            let m = 3 * cols;
             ev.reactions
                 .solve_prepared(&mut work.reactions, &mut work.b, m, &mut work.out);
-            for si in 0..3 {
-                for p in 0..cols {
-                    let col = si * cols + p;
-                    let st = &mut work.states[col * block..(col + 1) * block];
-                    // joint-major rows (6j + r) → component-major (r·J + j)
-                    for j in 0..nj {
-                        for r in 0..6 {
-                            st[n + r * nj + j] = work.out[(6 * j + r) * m + col];
+        }
+        work.scratch.pose = pose;
+        let reactions = &work.out[..if with_reactions { 6 * nj * m } else { 0 }];
+        let non_finite = work
+            .torques
+            .iter()
+            .chain(reactions)
+            .fold(false, |bad, x| bad | !x.is_finite());
+        if non_finite {
+            return Err((k, FailureReason::NonFinite));
+        }
+        // X0 = X(0), X1 = (X(1) − X(−1))/2, X2 = (X(1) + X(−1))/2 − X(0), per column; then
+        // |F_j(Δ)|² and |M_j(Δ)|² as quartics in Δ from the three components' quadratics.
+        let dst = &mut work.coefficients[k * stride..(k + 1) * stride];
+        let (torque_coefs, reaction_coefs) = dst.split_at_mut(3 * tq);
+        let (tc0, rest) = torque_coefs.split_at_mut(tq);
+        let (tc1, tc2) = rest.split_at_mut(tq);
+        let (x0, rest) = work.torques.split_at(tq);
+        let (xp, xm) = rest.split_at(tq);
+        for i in 0..tq {
+            tc0[i] = x0[i];
+            tc1[i] = 0.5 * (xp[i] - xm[i]);
+            tc2[i] = 0.5 * (xp[i] + xm[i]) - x0[i];
+        }
+        if with_reactions {
+            reaction_coefs.fill(0.0);
+            let (q0, rest) = reaction_coefs.split_at_mut(rq);
+            let (q1, rest) = rest.split_at_mut(rq);
+            let (q2, rest) = rest.split_at_mut(rq);
+            let (q3, q4) = rest.split_at_mut(rq);
+            for part in 0..2 {
+                for j in 0..nj {
+                    let slot = (part * nj + j) * cols..(part * nj + j + 1) * cols;
+                    let (q0, q1, q2) = (
+                        &mut q0[slot.clone()],
+                        &mut q1[slot.clone()],
+                        &mut q2[slot.clone()],
+                    );
+                    let (q3, q4) = (&mut q3[slot.clone()], &mut q4[slot]);
+                    for r in 0..3 {
+                        let row = 6 * j + 3 * part + r;
+                        let row = &reactions[row * m..(row + 1) * m];
+                        let (x0, rest) = row.split_at(cols);
+                        let (xp, xm) = rest.split_at(cols);
+                        for p in 0..cols {
+                            let c0 = x0[p];
+                            let c1 = 0.5 * (xp[p] - xm[p]);
+                            let c2 = 0.5 * (xp[p] + xm[p]) - c0;
+                            q0[p] += c0 * c0;
+                            q1[p] += 2.0 * c0 * c1;
+                            q2[p] += c1 * c1 + 2.0 * c0 * c2;
+                            q3[p] += 2.0 * c1 * c2;
+                            q4[p] += c2 * c2;
                         }
                     }
                 }
             }
         }
-        work.scratch.pose = pose;
-        // X0 = X(0), X1 = (X(1) − X(−1))/2, X2 = (X(1) + X(−1))/2 − X(0); per column the
-        // torque coefficients, then |F_j(Δ)|² and |M_j(Δ)|² as quartics in Δ.
-        let dst = &mut values[k * stride..(k + 1) * stride];
-        let len = cols * block;
-        let out_block = 3 * n + 10 * nj;
-        let mut coef = [[0.0f64; 3]; 3];
-        for p in 0..cols {
-            let get = |si: usize, i: usize| work.states[si * len + p * block + i];
-            let o = &mut dst[p * out_block..(p + 1) * out_block];
-            for i in 0..block {
-                let (x0, xp, xm) = (get(0, i), get(1, i), get(2, i));
-                if !(x0.is_finite() && xp.is_finite() && xm.is_finite()) {
-                    return Err((k, FailureReason::NonFinite));
-                }
-            }
-            for a in 0..n {
-                let (x0, xp, xm) = (get(0, a), get(1, a), get(2, a));
-                o[a] = x0;
-                o[n + a] = 0.5 * (xp - xm);
-                o[2 * n + a] = 0.5 * (xp + xm) - x0;
-            }
-            for j in 0..nj {
-                for (part, base) in [(0usize, 3 * n), (3, 3 * n + 5 * nj)] {
-                    for r in 0..3 {
-                        let i = n + (part + r) * nj + j;
-                        let (x0, xp, xm) = (get(0, i), get(1, i), get(2, i));
-                        coef[r] = [x0, 0.5 * (xp - xm), 0.5 * (xp + xm) - x0];
-                    }
-                    let d =
-                        |u: usize, v: usize| (0..3).map(|r| coef[r][u] * coef[r][v]).sum::<f64>();
-                    o[base + j] = d(0, 0);
-                    o[base + nj + j] = 2.0 * d(0, 1);
-                    o[base + 2 * nj + j] = d(1, 1) + 2.0 * d(0, 2);
-                    o[base + 3 * nj + j] = 2.0 * d(1, 2);
-                    o[base + 4 * nj + j] = d(2, 2);
-                }
-            }
-        }
     }
-    Ok(SubTaskData { stride, values })
+    Ok(())
 }

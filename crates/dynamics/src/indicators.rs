@@ -202,6 +202,14 @@ impl StatsTable {
         self.ok[w] = true;
     }
 
+    /// Stores task `w`'s rows (all columns, `columns × width` values in row layout) and marks
+    /// it as run.
+    pub fn set_rows(&mut self, w: usize, rows: &[f64]) {
+        let n = self.columns * self.width();
+        self.data[w * n..(w + 1) * n].copy_from_slice(rows);
+        self.ok[w] = true;
+    }
+
     /// Copies task `from`'s rows to task `to`.
     pub fn copy_task(&mut self, from: usize, to: usize) {
         let n = self.columns * self.width();

@@ -60,13 +60,45 @@ impl JointInfo {
     }
 }
 
-/// A joint's geometry at one sample (world axes).
+/// A joint's geometry at one sample (world axes): its point, its axis, and the directions of
+/// its force and moment unknowns (held inline: frames are rebuilt at every sample).
 #[derive(Clone, Debug, Default)]
 pub struct JointFrame {
     pub point: Vector3<f64>,
     pub axis: Vector3<f64>,
-    pub forces: Vec<Vector3<f64>>,
-    pub moments: Vec<Vector3<f64>>,
+    directions: [Vector3<f64>; 6],
+    force_count: usize,
+    moment_count: usize,
+}
+
+impl JointFrame {
+    fn new(
+        point: Vector3<f64>,
+        axis: Vector3<f64>,
+        forces: &[Vector3<f64>],
+        moments: &[Vector3<f64>],
+    ) -> JointFrame {
+        let mut directions = [Vector3::zeros(); 6];
+        directions[..forces.len()].copy_from_slice(forces);
+        directions[forces.len()..forces.len() + moments.len()].copy_from_slice(moments);
+        JointFrame {
+            point,
+            axis,
+            directions,
+            force_count: forces.len(),
+            moment_count: moments.len(),
+        }
+    }
+
+    /// Directions of the force unknowns.
+    pub fn forces(&self) -> &[Vector3<f64>] {
+        &self.directions[..self.force_count]
+    }
+
+    /// Directions of the moment unknowns.
+    pub fn moments(&self) -> &[Vector3<f64>] {
+        &self.directions[self.force_count..self.force_count + self.moment_count]
+    }
 }
 
 /// Two unit vectors completing `e` to an orthonormal basis (deterministic).
@@ -215,44 +247,43 @@ impl ReactionSolver {
 
     /// Joint geometry at the sample whose poses are in `pose`.
     pub fn frames(&self, mech: &Mechanism, pose: &[f64]) -> Vec<JointFrame> {
-        self.joints
-            .iter()
-            .map(|j| {
-                let (r0, p0) = mech.pose_of(pose, j.bodies[0]);
-                let (r1, p1) = mech.pose_of(pose, j.bodies[1]);
-                let point = if j.kind == JointKind::Prismatic {
-                    p1 + r1 * j.points[1]
-                } else {
-                    p0 + r0 * j.points[0]
-                };
-                let axis = r0 * j.axis0;
-                let (e1, e2) = perpendiculars(&axis);
-                let xyz = vec![Vector3::x(), Vector3::y(), Vector3::z()];
-                let (forces, moments) = match j.kind {
-                    JointKind::Revolute => (xyz, vec![e1, e2]),
-                    JointKind::Prismatic => (vec![e1, e2], xyz),
-                    JointKind::Spherical => (xyz, vec![]),
-                    JointKind::Universal => {
-                        let second = r1 * j.axis2.unwrap_or(e1);
-                        let normal = axis.cross(&second);
-                        let normal = if normal.norm() > 1e-12 {
-                            normal.normalize()
-                        } else {
-                            e1
-                        };
-                        (xyz, vec![normal])
-                    }
-                    JointKind::Fixed => (xyz.clone(), xyz),
-                    JointKind::Orientation => (vec![], xyz),
-                };
-                JointFrame {
-                    point,
-                    axis,
-                    forces,
-                    moments,
+        let mut frames = Vec::with_capacity(self.joints.len());
+        self.frames_into(mech, pose, &mut frames);
+        frames
+    }
+
+    /// [`Self::frames`] into a reused buffer.
+    fn frames_into(&self, mech: &Mechanism, pose: &[f64], frames: &mut Vec<JointFrame>) {
+        frames.clear();
+        frames.extend(self.joints.iter().map(|j| {
+            let (r0, p0) = mech.pose_of(pose, j.bodies[0]);
+            let (r1, p1) = mech.pose_of(pose, j.bodies[1]);
+            let point = if j.kind == JointKind::Prismatic {
+                p1 + r1 * j.points[1]
+            } else {
+                p0 + r0 * j.points[0]
+            };
+            let axis = r0 * j.axis0;
+            let (e1, e2) = perpendiculars(&axis);
+            let xyz = [Vector3::x(), Vector3::y(), Vector3::z()];
+            match j.kind {
+                JointKind::Revolute => JointFrame::new(point, axis, &xyz, &[e1, e2]),
+                JointKind::Prismatic => JointFrame::new(point, axis, &[e1, e2], &xyz),
+                JointKind::Spherical => JointFrame::new(point, axis, &xyz, &[]),
+                JointKind::Universal => {
+                    let second = r1 * j.axis2.unwrap_or(e1);
+                    let normal = axis.cross(&second);
+                    let normal = if normal.norm() > 1e-12 {
+                        normal.normalize()
+                    } else {
+                        e1
+                    };
+                    JointFrame::new(point, axis, &xyz, &[normal])
                 }
-            })
-            .collect()
+                JointKind::Fixed => JointFrame::new(point, axis, &xyz, &xyz),
+                JointKind::Orientation => JointFrame::new(point, axis, &[], &xyz),
+            }
+        }));
     }
 
     /// `A` (`6L × K`): column per unknown, rows `[F; N_o]` per body.
@@ -260,7 +291,7 @@ impl ReactionSolver {
         let mut a = DMatrix::zeros(6 * self.bodies, self.unknowns);
         for (j, f) in self.joints.iter().zip(frames) {
             let mut col = j.offset;
-            for e in &f.forces {
+            for e in f.forces() {
                 for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
                     if let BodyId::Body(b) = j.bodies[side] {
                         let m = (f.point - kin[b].p).cross(e);
@@ -272,7 +303,7 @@ impl ReactionSolver {
                 }
                 col += 1;
             }
-            for e in &f.moments {
+            for e in f.moments() {
                 for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
                     if let BodyId::Body(b) = j.bodies[side] {
                         for r in 0..3 {
@@ -357,11 +388,11 @@ impl ReactionSolver {
                     let mut force = Vector3::zeros();
                     let mut moment = Vector3::zeros();
                     let mut col = j.offset;
-                    for e in &f.forces {
+                    for e in f.forces() {
                         force += e * lambda[(col, c)];
                         col += 1;
                     }
-                    for e in &f.moments {
+                    for e in f.moments() {
                         moment += e * lambda[(col, c)];
                         col += 1;
                     }
@@ -418,13 +449,13 @@ impl ReactionSolver {
         let k = self.unknowns;
         work.rows = rows;
         work.k = k;
-        work.frames = self.frames(mech, pose);
+        self.frames_into(mech, pose, &mut work.frames);
         work.kappas = self.kappas(&work.frames, kin, lu, mech.n);
         work.a.clear();
         work.a.resize(rows * k, 0.0);
         for (j, f) in self.joints.iter().zip(&work.frames) {
             let mut col = j.offset;
-            for e in &f.forces {
+            for e in f.forces() {
                 for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
                     if let BodyId::Body(b) = j.bodies[side] {
                         let m = (f.point - kin[b].p).cross(e);
@@ -436,7 +467,7 @@ impl ReactionSolver {
                 }
                 col += 1;
             }
-            for e in &f.moments {
+            for e in f.moments() {
                 for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
                     if let BodyId::Body(b) = j.bodies[side] {
                         for r in 0..3 {
@@ -460,8 +491,10 @@ impl ReactionSolver {
         if self.fast {
             // S = A Aᵀ + U Uᵀ (upper triangle, row-major), then S = Rᵀ R in place with
             // R = Lᵀ upper triangular.
+            let stride = padded(rows);
+            work.stride = stride;
             work.lt.clear();
-            work.lt.resize(rows * rows, 0.0);
+            work.lt.resize(rows * stride, 0.0);
             for c in 0..k {
                 let col = &work.a[c * rows..(c + 1) * rows];
                 let nz = &work.nz[c];
@@ -470,7 +503,7 @@ impl ReactionSolver {
                     if x == 0.0 {
                         continue;
                     }
-                    let row = &mut work.lt[r1 * rows..(r1 + 1) * rows];
+                    let row = &mut work.lt[r1 * stride..r1 * stride + rows];
                     for &r2 in &nz[i..] {
                         row[r2] += x * col[r2];
                     }
@@ -482,13 +515,23 @@ impl ReactionSolver {
                     if x == 0.0 {
                         continue;
                     }
-                    let row = &mut work.lt[r1 * rows + r1..(r1 + 1) * rows];
+                    let row = &mut work.lt[r1 * stride + r1..r1 * stride + rows];
                     for (v, &y) in row.iter_mut().zip(&uc[r1..]) {
                         *v += x * y;
                     }
                 }
             }
-            if cholesky_upper_in_place(&mut work.lt, rows) {
+            if cholesky_upper_in_place(&mut work.lt, rows, stride) {
+                work.l.clear();
+                work.l.resize(rows * rows, 0.0);
+                for i in 0..rows {
+                    for j in i..rows {
+                        work.l[j * rows + i] = work.lt[i * stride + j];
+                    }
+                }
+                work.inv_diag.clear();
+                work.inv_diag
+                    .extend((0..rows).map(|i| 1.0 / work.lt[i * stride + i]));
                 return;
             }
         }
@@ -559,25 +602,22 @@ impl ReactionSolver {
                 }
             }
         } else {
-            chunk_solve(
-                &work.lt,
+            let factor = Factor {
                 rows,
-                &work.a,
-                &work.nz,
-                k,
-                b,
-                m,
-                &mut work.y,
-                &mut work.z,
-            );
+                l: &work.l,
+                lt: &work.lt,
+                stride: work.stride,
+                inv_diag: &work.inv_diag,
+            };
+            chunk_solve(factor, &work.a, &work.nz, k, b, m, &mut work.y, &mut work.z);
         }
         out[..6 * self.joints.len() * m].fill(0.0);
         for (jn, (j, f)) in self.joints.iter().zip(&work.frames).enumerate() {
             let bases = f
-                .forces
+                .forces()
                 .iter()
                 .map(|e| (e, 0))
-                .chain(f.moments.iter().map(|e| (e, 3)));
+                .chain(f.moments().iter().map(|e| (e, 3)));
             for (col, (e, base)) in (j.offset..).zip(bases) {
                 let lam = &work.y[col * m..(col + 1) * m];
                 for r in 0..3 {
@@ -627,8 +667,13 @@ pub struct ReactionWork {
     nz: Vec<Vec<usize>>,
     /// Orthonormal mobility basis, column-major.
     u: Vec<f64>,
-    /// `Lᵀ` (upper triangular) of `AAᵀ + UUᵀ = L Lᵀ`, row-major.
+    /// `Lᵀ` (upper triangular) of `AAᵀ + UUᵀ = L Lᵀ`, row-major with row stride `stride`.
     lt: Vec<f64>,
+    stride: usize,
+    /// `L`, row-major.
+    l: Vec<f64>,
+    /// `1 / L_ii`.
+    inv_diag: Vec<f64>,
     /// `A⁺` when the fast path is off or failed.
     pinv: Option<DMatrix<f64>>,
     y: Vec<f64>,
@@ -637,22 +682,64 @@ pub struct ReactionWork {
 
 crate::simd::multiversion! {
 /// Cholesky factorisation `S = Rᵀ R` in place: `s` holds the upper triangle of `S` row-major
-/// and receives the upper triangular `R` (= `Lᵀ`; the strict lower triangle is left zero).
+/// (row stride `stride`, a multiple of [`LANE`]) and receives the upper triangular `R`
+/// (= `Lᵀ`; the strict lower triangle and the padding hold values that must not be read).
 /// Row `j` of `R` is updated by contiguous multiply-adds with the rows above it. False when
 /// `S` is not numerically positive definite.
-fn cholesky_upper_in_place(s: &mut [f64], n: usize) -> bool {
-    let max_diag = (0..n).fold(0.0f64, |m, i| m.max(s[i * n + i]));
+fn cholesky_upper_in_place(s: &mut [f64], n: usize, stride: usize) -> bool {
+    let max_diag = (0..n).fold(0.0f64, |m, i| m.max(s[i * stride + i]));
     for j in 0..n {
-        let (above, rest) = s.split_at_mut(j * n);
-        let row_j = &mut rest[j..n];
-        for row_k in above.chunks_exact(n) {
-            let x = row_k[j];
-            if x != 0.0 {
-                for (v, &y) in row_j.iter_mut().zip(&row_k[j..n]) {
-                    *v -= x * y;
+        // Updates run over whole lanes of eight from the one holding column `j` to the padded
+        // end of the row: the entries left of the diagonal and in the padding receive values
+        // that are never read, and the loops have no scalar remainder.
+        let from = j / LANE * LANE;
+        let (above, rest) = s.split_at_mut(j * stride);
+        let row_j = &mut rest[from..stride];
+        // Four rows above at a time: one load and store of row j per four multiply-adds.
+        let blocks = above.chunks_exact(4 * stride);
+        let tail = blocks.remainder();
+        for block in blocks {
+            let (r0, rest) = block.split_at(stride);
+            let (r1, rest) = rest.split_at(stride);
+            let (r2, r3) = rest.split_at(stride);
+            let (x0, x1, x2, x3) = (r0[j], r1[j], r2[j], r3[j]);
+            for ((((v, a), b), c), d) in row_j
+                .chunks_exact_mut(LANE)
+                .zip(r0[from..].chunks_exact(LANE))
+                .zip(r1[from..].chunks_exact(LANE))
+                .zip(r2[from..].chunks_exact(LANE))
+                .zip(r3[from..].chunks_exact(LANE))
+            {
+                let v: &mut [f64; LANE] = v.try_into().expect("whole lane");
+                let (a, b): (&[f64; LANE], &[f64; LANE]) = (a.try_into().expect("lane"), b.try_into().expect("lane"));
+                let (c, d): (&[f64; LANE], &[f64; LANE]) = (c.try_into().expect("lane"), d.try_into().expect("lane"));
+                // Copies in registers: the compiler cannot see that `v` and the rows above
+                // do not overlap and would otherwise keep the lane loop scalar.
+                let (a, b, c, d) = (*a, *b, *c, *d);
+                let mut acc = *v;
+                for i in 0..LANE {
+                    acc[i] -= (x0 * a[i] + x1 * b[i]) + (x2 * c[i] + x3 * d[i]);
                 }
+                *v = acc;
             }
         }
+        for row_k in tail.chunks_exact(stride) {
+            let x = row_k[j];
+            for (v, y) in row_j
+                .chunks_exact_mut(LANE)
+                .zip(row_k[from..].chunks_exact(LANE))
+            {
+                let v: &mut [f64; LANE] = v.try_into().expect("whole lane");
+                let y: &[f64; LANE] = y.try_into().expect("whole lane");
+                let y = *y;
+                let mut acc = *v;
+                for i in 0..LANE {
+                    acc[i] -= x * y[i];
+                }
+                *v = acc;
+            }
+        }
+        let row_j = &mut row_j[j - from..n - from];
         let d = row_j[0];
         if d.is_nan() || d <= 1e-13 * max_diag {
             return false;
@@ -668,19 +755,33 @@ fn cholesky_upper_in_place(s: &mut [f64], n: usize) -> bool {
 }
 }
 
-/// `acc += x · v` on `W` lanes.
+/// Lane width of the padded factor rows.
+const LANE: usize = 8;
+
+/// `n` rounded up to whole lanes.
+fn padded(n: usize) -> usize {
+    n.div_ceil(LANE) * LANE
+}
+
+/// One value per right-hand side of a chunk, aligned so that a whole row is one cache line
+/// (an unaligned 64-byte vector load that straddles two lines costs twice).
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
+pub(crate) struct Lanes([f64; LANE]);
+
+/// `acc += x · v` on all lanes.
 #[inline(always)]
-fn axpy<const W: usize>(acc: &mut [f64; W], x: f64, v: &[f64; W]) {
-    for p in 0..W {
-        acc[p] += x * v[p];
+fn axpy(acc: &mut [f64; LANE], x: f64, v: &Lanes) {
+    for p in 0..LANE {
+        acc[p] += x * v.0[p];
     }
 }
 
-/// `Σ_j w[j] · v[j]` over `W` lanes with four interleaved partial sums (independent
+/// `Σ_j w[j] · v[j]` over all lanes with four interleaved partial sums (independent
 /// dependency chains; fixed order).
 #[inline(always)]
-fn combo<const W: usize>(w: &[f64], v: &[[f64; W]]) -> [f64; W] {
-    let mut s = [[0.0; W]; 4];
+fn combo(w: &[f64], v: &[Lanes]) -> [f64; LANE] {
+    let mut s = [[0.0; LANE]; 4];
     let chunks = w.chunks_exact(4);
     let rem = chunks.remainder();
     for (wc, vc) in chunks.zip(v.chunks_exact(4)) {
@@ -693,8 +794,31 @@ fn combo<const W: usize>(w: &[f64], v: &[[f64; W]]) -> [f64; W] {
     for (k, &x) in rem.iter().enumerate() {
         axpy(&mut s[k], x, &v[tail + k]);
     }
-    let mut out = [0.0; W];
-    for p in 0..W {
+    let mut out = [0.0; LANE];
+    for p in 0..LANE {
+        out[p] = (s[0][p] + s[1][p]) + (s[2][p] + s[3][p]);
+    }
+    out
+}
+
+/// `Σ_r w[r] · v[r]` over the rows `r` in `rows`, with the interleaved partial sums of
+/// [`combo`].
+#[inline(always)]
+fn sparse_combo(w: &[f64], rows: &[usize], v: &[Lanes]) -> [f64; LANE] {
+    let mut s = [[0.0; LANE]; 4];
+    let chunks = rows.chunks_exact(4);
+    let rem = chunks.remainder();
+    for rc in chunks {
+        axpy(&mut s[0], w[rc[0]], &v[rc[0]]);
+        axpy(&mut s[1], w[rc[1]], &v[rc[1]]);
+        axpy(&mut s[2], w[rc[2]], &v[rc[2]]);
+        axpy(&mut s[3], w[rc[3]], &v[rc[3]]);
+    }
+    for (k, &r) in rem.iter().enumerate() {
+        axpy(&mut s[k], w[r], &v[r]);
+    }
+    let mut out = [0.0; LANE];
+    for p in 0..LANE {
         out[p] = (s[0][p] + s[1][p]) + (s[2][p] + s[3][p]);
     }
     out
@@ -703,16 +827,29 @@ fn combo<const W: usize>(w: &[f64], v: &[[f64; W]]) -> [f64; W] {
 /// Scratch of [`chunk_solve`]: one row of lanes per equation.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SolveScratch {
-    z8: Vec<[f64; 8]>,
+    z: Vec<Lanes>,
+}
+
+/// The factor `S = L Lᵀ` in the two layouts the substitutions read contiguously.
+#[derive(Clone, Copy)]
+struct Factor<'a> {
+    rows: usize,
+    /// `L`, row-major (lower triangle; row `i` holds `L_i0 … L_ii`).
+    l: &'a [f64],
+    /// `Lᵀ`, row-major (upper triangle) with row stride `stride`.
+    lt: &'a [f64],
+    stride: usize,
+    /// `1 / L_ii`.
+    inv_diag: &'a [f64],
 }
 
 crate::simd::multiversion! {
 /// `y = Aᵀ (L Lᵀ)⁻¹ b` for `m` right-hand sides (`b` row-major `rows × m`; `y` row-major
-/// `k × m`; `lt` = `Lᵀ` row-major), eight right-hand sides at a time (sixteen measured
-/// slower: the wider accumulators spill).
+/// `k × m`), [`LANE`] right-hand sides at a time. Both substitutions
+/// are in dot-product form over contiguous rows: the inner loop keeps four independent
+/// accumulators in registers and stores each unknown once.
 fn chunk_solve(
-    lt: &[f64],
-    rows: usize,
+    factor: Factor<'_>,
     a: &[f64],
     nz: &[Vec<usize>],
     k: usize,
@@ -721,17 +858,17 @@ fn chunk_solve(
     y: &mut [f64],
     z: &mut SolveScratch,
 ) {
-    z.z8.resize(rows, [0.0; 8]);
-    for c0 in (0..m).step_by(8) {
-        solve_lanes::<8>(lt, rows, a, nz, k, b, m, c0, y, &mut z.z8);
+    z.z.resize(factor.rows, Lanes::default());
+    for c0 in (0..m).step_by(LANE) {
+        solve_lanes(factor, a, nz, k, b, m, c0, y, &mut z.z);
     }
 }
 }
 
 #[inline(always)]
-fn solve_lanes<const W: usize>(
-    lt: &[f64],
-    rows: usize,
+#[allow(clippy::too_many_arguments)]
+fn solve_lanes(
+    factor: Factor<'_>,
     a: &[f64],
     nz: &[Vec<usize>],
     k: usize,
@@ -739,44 +876,38 @@ fn solve_lanes<const W: usize>(
     m: usize,
     c0: usize,
     y: &mut [f64],
-    z: &mut [[f64; W]],
+    z: &mut [Lanes],
 ) {
-    let width = W.min(m - c0);
-    // L z = b, column by column: z_j = b_j / L_jj, then b_i −= L_ij z_j (i > j)
-    for (i, zi) in z.iter_mut().enumerate() {
-        let mut v = [0.0; W];
-        v[..width].copy_from_slice(&b[i * m + c0..i * m + c0 + width]);
-        *zi = v;
-    }
-    for j in 0..rows {
-        let d = 1.0 / lt[j * rows + j];
-        let mut zj = z[j];
-        for v in zj.iter_mut() {
-            *v *= d;
+    let rows = factor.rows;
+    let width = LANE.min(m - c0);
+    // L z = b: z_i = (b_i − Σ_{j<i} L_ij z_j) / L_ii
+    for i in 0..rows {
+        let s = combo(&factor.l[i * rows..i * rows + i], &z[..i]);
+        let d = factor.inv_diag[i];
+        let mut zi = [0.0; LANE];
+        zi[..width].copy_from_slice(&b[i * m + c0..i * m + c0 + width]);
+        for p in 0..LANE {
+            zi[p] = (zi[p] - s[p]) * d;
         }
-        z[j] = zj;
-        let col = &lt[j * rows + j + 1..(j + 1) * rows];
-        for (zi, &x) in z[j + 1..].iter_mut().zip(col) {
-            axpy(zi, -x, &zj);
-        }
+        z[i] = Lanes(zi);
     }
     // Lᵀ y = z
     for i in (0..rows).rev() {
-        let s = combo(&lt[i * rows + i + 1..(i + 1) * rows], &z[i + 1..rows]);
-        let d = 1.0 / lt[i * rows + i];
-        let mut yi = z[i];
-        for p in 0..W {
+        let s = combo(
+            &factor.lt[i * factor.stride + i + 1..i * factor.stride + rows],
+            &z[i + 1..rows],
+        );
+        let d = factor.inv_diag[i];
+        let mut yi = z[i].0;
+        for p in 0..LANE {
             yi[p] = (yi[p] - s[p]) * d;
         }
-        z[i] = yi;
+        z[i] = Lanes(yi);
     }
     // λ = Aᵀ y
     for c in 0..k {
         let col = &a[c * rows..(c + 1) * rows];
-        let mut acc = [0.0; W];
-        for &r in &nz[c] {
-            axpy(&mut acc, col[r], &z[r]);
-        }
+        let acc = sparse_combo(col, &nz[c], z);
         y[c * m + c0..c * m + c0 + width].copy_from_slice(&acc[..width]);
     }
 }

@@ -197,6 +197,24 @@ fn cyclic_shortcut_matches_direct_evaluation() {
                 other_anchor: [0.1, -0.3, 0.0],
             }],
         },
+        // Four columns: the shared-regressor path, and 3 × 4 = 12 reaction right-hand sides
+        // per sample — more than one lane chunk of the solver, the last one partial.
+        Variant {
+            counterweights: vec![Counterweight {
+                body: 2,
+                mass: 25.0,
+                position: [0.1, -0.2, 0.05],
+            }],
+            springs: vec![],
+        },
+        Variant {
+            counterweights: vec![Counterweight {
+                body: 6,
+                mass: 40.0,
+                position: [-0.2, 0.0, 0.1],
+            }],
+            springs: vec![],
+        },
     ];
     let params = ParameterSet::from_variants(&model, &variants).unwrap();
     let fast = evaluate_grid(&model, &params, &EvaluateOptions::default()).unwrap();
