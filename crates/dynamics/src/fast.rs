@@ -16,6 +16,13 @@
 //! sub-task with `−Δ` at `T − t` (all velocities negated, accelerations unchanged). Tasks with
 //! the same sub-task, direction and `Δ` have identical statistics and are computed once.
 //! The palletizer's 343 points have 49 sub-points: 1,225 sub-tasks instead of 58,653 tasks.
+//!
+//! Springs are static: their forces depend on `q` only, not on `Δ`. Two parameter columns
+//! with the same inertial parameters (every body block, counterweights included) therefore
+//! differ by a `Δ`-independent amount in every output, `X_p(Δ) = X_r(Δ) + X_p(0) − X_r(0)`.
+//! Columns are grouped by their inertial parameters; only the first column of each group is
+//! evaluated at `Δ = ±1`, the others at `Δ = 0` alone. Spring-only variants share the
+//! unbalanced robot's inertia, so a batch of them costs one third of the reaction solves.
 
 use std::collections::HashMap;
 
@@ -40,18 +47,57 @@ struct Work {
     scratch: Scratch,
     kin: Vec<BodyKin>,
     regressors: Vec<WrenchRegressor>,
-    reactions: ReactionWork,
+    reactions_work: ReactionWork,
     w: Vec<f64>,
     b: Vec<f64>,
     out: Vec<f64>,
     /// Motor torques at `Δ ∈ {0, 1, −1}`: `[Δ][actuator][column]`.
     torques: Vec<f64>,
+    /// Motor torques of the group representatives at `Δ = ±1`: `[Δ][actuator][group]`.
+    rep_torques: Vec<f64>,
+    /// Joint wrench components at `Δ ∈ {0, 1, −1}`: `[joint row][Δ][column]`.
+    reactions: Vec<f64>,
     /// Coefficients of the current sub-task, per sample (`stride` values): the motor torques
     /// as quadratics in `Δ` — three arrays `[actuator][column]` — then, with reactions,
     /// `|F_j|²` and `|M_j|²` as quartics — five arrays `[force/moment][joint][column]`.
     /// Columns run innermost so that every task evaluation is a contiguous, vectorisable
     /// sweep. Reused from sub-task to sub-task (every value is overwritten).
     coefficients: Vec<f64>,
+}
+
+/// Parameter columns grouped by their inertial parameters (see the module doc).
+struct InertiaGroups {
+    /// Every column, in order.
+    all: Vec<usize>,
+    /// Per column, its group.
+    group: Vec<usize>,
+    /// Per group, its first column (the representative).
+    reps: Vec<usize>,
+}
+
+impl InertiaGroups {
+    fn new(params: &ParameterSet) -> InertiaGroups {
+        let inertial = crate::params::BODY_PARAMS * params.bodies;
+        let mut index: HashMap<Vec<u64>, usize> = HashMap::new();
+        let mut reps = Vec::new();
+        let group = (0..params.len())
+            .map(|p| {
+                let key = params.column(p)[..inertial]
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .collect();
+                *index.entry(key).or_insert_with(|| {
+                    reps.push(p);
+                    reps.len() - 1
+                })
+            })
+            .collect();
+        InertiaGroups {
+            all: (0..params.len()).collect(),
+            group,
+            reps,
+        }
+    }
 }
 
 /// Outcome of one sub-task: the statistics of its distinct tasks and, per task, which one
@@ -177,6 +223,7 @@ pub(crate) fn evaluate_cyclic(
         0
     };
     let per_sample_stride = params.len() * (3 * na + 10 * nj);
+    let groups = InertiaGroups::new(params);
     let computed: Vec<SubTaskOutcome> = (0..st_pairs.len())
         .into_par_iter()
         .map_init(Work::default, |work, st| {
@@ -192,6 +239,7 @@ pub(crate) fn evaluate_cyclic(
                     tasks.duration,
                     ns,
                     params,
+                    &groups,
                     with_reactions,
                     per_sample_stride,
                     work,
@@ -362,6 +410,7 @@ fn sub_task(
     duration: f64,
     ns: usize,
     params: &ParameterSet,
+    groups: &InertiaGroups,
     with_reactions: bool,
     stride: usize,
     work: &mut Work,
@@ -379,6 +428,9 @@ fn sub_task(
     let m = 3 * cols;
     let tq = n * cols;
     let rq = 2 * nj * cols;
+    let nreps = groups.reps.len();
+    // right-hand sides solved: every column at Δ = 0, the representatives at Δ = ±1
+    let solved = cols + 2 * nreps;
     work.coefficients.resize(ns * stride, 0.0);
     let mut q = q0.to_vec();
     let mut u = [0.0; MAX_VARS];
@@ -388,9 +440,11 @@ fn sub_task(
     let mut g = [0.0; MAX_VARS * MAX_VARS];
     work.w.resize(rows, 0.0);
     work.torques.resize(3 * tq, 0.0);
+    work.rep_torques.resize(2 * n * nreps, 0.0);
     if with_reactions {
-        work.b.resize(rows * m, 0.0);
-        work.out.resize(6 * nj * m, 0.0);
+        work.b.resize(rows * solved, 0.0);
+        work.out.resize(6 * nj * solved, 0.0);
+        work.reactions.resize(6 * nj * m, 0.0);
     }
     for k in 0..ns {
         let t = sample_time(k, ns, duration);
@@ -410,7 +464,7 @@ fn sub_task(
         work.kin.extend((0..l).map(|b| mech.body_frame(&pose, b)));
         if with_reactions {
             ev.reactions
-                .prepare(mech, &pose, &work.kin, &lu, &mut work.reactions);
+                .prepare(mech, &pose, &work.kin, &lu, &mut work.reactions_work);
         }
         for (si, d) in [0.0, 1.0, -1.0].into_iter().enumerate() {
             let mut qd = ud;
@@ -424,9 +478,10 @@ fn sub_task(
                 qdd[a] -= bias[a];
             }
             lu.solve(&mut qdd);
+            let columns = if si == 0 { &groups.all } else { &groups.reps };
             // With several columns, one wrench regressor per body serves them all; with one,
             // the direct Newton–Euler wrench is cheaper.
-            let shared = cols > 2;
+            let shared = columns.len() > 2;
             work.regressors.clear();
             for (b, kin) in work.kin.iter_mut().enumerate() {
                 mech.set_motion(&pose, b, kin, &qd, &qdd);
@@ -434,7 +489,7 @@ fn sub_task(
                     work.regressors.push(wrench_regressor(kin, &mech.gravity));
                 }
             }
-            for p in 0..cols {
+            for (c, &p) in columns.iter().enumerate() {
                 if shared {
                     required_wrenches_with(mech, &pose, &work.regressors, params, p, &mut work.w);
                 } else {
@@ -442,24 +497,71 @@ fn sub_task(
                 }
                 let qu = actuator_forces(&work.kin, &work.w, n, &lu);
                 for a in 0..n {
-                    work.torques[(si * n + a) * cols + p] = qu[a] * ev.ratios[a];
+                    let torque = qu[a] * ev.ratios[a];
+                    if si == 0 {
+                        work.torques[a * cols + p] = torque;
+                    } else {
+                        work.rep_torques[((si - 1) * n + a) * nreps + c] = torque;
+                    }
                 }
                 if with_reactions {
-                    ev.reactions
-                        .subtract_actuators(&work.reactions, &work.kin, &qu, &mut work.w);
-                    let col = si * cols + p;
+                    ev.reactions.subtract_actuators(
+                        &work.reactions_work,
+                        &work.kin,
+                        &qu,
+                        &mut work.w,
+                    );
+                    let col = if si == 0 {
+                        p
+                    } else {
+                        cols + (si - 1) * nreps + c
+                    };
                     for r in 0..rows {
-                        work.b[r * m + col] = work.w[r];
+                        work.b[r * solved + col] = work.w[r];
                     }
                 }
             }
         }
         if with_reactions {
-            ev.reactions
-                .solve_prepared(&mut work.reactions, &mut work.b, m, &mut work.out);
+            ev.reactions.solve_prepared(
+                &mut work.reactions_work,
+                &mut work.b,
+                solved,
+                &mut work.out,
+            );
         }
         work.scratch.pose = pose;
-        let reactions = &work.out[..if with_reactions { 6 * nj * m } else { 0 }];
+        // Every column at Δ = ±1 from its representative: X_p(±1) = X_r(±1) + X_p(0) − X_r(0)
+        // (exact for the representative itself).
+        {
+            let (at_zero, at_pm) = work.torques.split_at_mut(tq);
+            for si in 0..2 {
+                for a in 0..n {
+                    let zero = &at_zero[a * cols..(a + 1) * cols];
+                    let rep = &work.rep_torques[(si * n + a) * nreps..(si * n + a + 1) * nreps];
+                    let dst = &mut at_pm[(si * n + a) * cols..(si * n + a + 1) * cols];
+                    for (p, v) in dst.iter_mut().enumerate() {
+                        let g = groups.group[p];
+                        *v = rep[g] + (zero[p] - zero[groups.reps[g]]);
+                    }
+                }
+            }
+        }
+        if with_reactions {
+            for row in 0..6 * nj {
+                let src = &work.out[row * solved..(row + 1) * solved];
+                let dst = &mut work.reactions[row * m..(row + 1) * m];
+                dst[..cols].copy_from_slice(&src[..cols]);
+                for si in 0..2 {
+                    let rep = &src[cols + si * nreps..cols + (si + 1) * nreps];
+                    for p in 0..cols {
+                        let g = groups.group[p];
+                        dst[(si + 1) * cols + p] = rep[g] + (src[p] - src[groups.reps[g]]);
+                    }
+                }
+            }
+        }
+        let reactions = &work.reactions[..if with_reactions { 6 * nj * m } else { 0 }];
         let non_finite = work
             .torques
             .iter()

@@ -197,8 +197,8 @@ fn cyclic_shortcut_matches_direct_evaluation() {
                 other_anchor: [0.1, -0.3, 0.0],
             }],
         },
-        // Four columns: the shared-regressor path, and 3 × 4 = 12 reaction right-hand sides
-        // per sample — more than one lane chunk of the solver, the last one partial.
+        // More than two columns (the shared-regressor path) and more reaction right-hand
+        // sides per sample than one lane chunk of the solver, the last chunk partial.
         Variant {
             counterweights: vec![Counterweight {
                 body: 2,
@@ -214,6 +214,28 @@ fn cyclic_shortcut_matches_direct_evaluation() {
                 position: [-0.2, 0.0, 0.1],
             }],
             springs: vec![],
+        },
+        // Spring-only variants: the unbalanced robot's inertia, so they share its Δ = ±1
+        // evaluations and differ from it by static terms only.
+        Variant {
+            counterweights: vec![],
+            springs: vec![Spring {
+                body: 5,
+                other: Some(1),
+                stiffness: 5000.0,
+                anchor: [-0.1, 0.2, 0.0],
+                other_anchor: [0.0, 0.3, 0.05],
+            }],
+        },
+        Variant {
+            counterweights: vec![],
+            springs: vec![Spring {
+                body: 6,
+                other: Some(2),
+                stiffness: 1500.0,
+                anchor: [0.3, 0.0, 0.1],
+                other_anchor: [-0.2, 0.1, 0.0],
+            }],
         },
     ];
     let params = ParameterSet::from_variants(&model, &variants).unwrap();
