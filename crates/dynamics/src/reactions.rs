@@ -29,10 +29,11 @@
 use counterpoise_model::{BodyId, JointKind, Model};
 use nalgebra::{DMatrix, DVector, Vector3};
 
+use crate::kernel::required_wrenches_with;
 use crate::lu::SmallLu;
 use crate::mechanism::{BodyKin, Mechanism, Scratch};
-use crate::params::{BODY_PARAMS, ParameterSet};
-use crate::regressor::{SampleRegressor, spring_wrenches};
+use crate::params::ParameterSet;
+use crate::regressor::SampleRegressor;
 
 /// Relative singular-value threshold of the pseudo-inverse.
 pub const RANK_TOLERANCE: f64 = 1e-10;
@@ -320,7 +321,9 @@ impl ReactionSolver {
     /// Joint reactions for every parameter column at one sample.
     ///
     /// `reg` holds the sample's body kinematics and wrench regressors, `lu` the LU of `G`,
-    /// `actuator_forces[p]` the actuator forces `Q_u` of column `p`.
+    /// `actuator_forces[p]` the actuator forces `Q_u` of column `p`; `work` is reused scratch.
+    /// The same factorisation and solve as the grid path ([`Self::prepare`],
+    /// [`Self::solve_prepared`]).
     #[allow(clippy::too_many_arguments)]
     pub fn solve(
         &self,
@@ -331,75 +334,34 @@ impl ReactionSolver {
         params: &ParameterSet,
         columns: &[usize],
         actuator_forces: &[[f64; counterpoise_symbolic::MAX_VARS]],
+        work: &mut ReactionWork,
     ) -> Vec<JointReactions> {
         let kin = &reg.kin;
-        let frames = self.frames(mech, pose);
-        let a = self.matrix(&frames, kin);
         let rows = 6 * self.bodies;
-        let l = self.bodies;
-        let kappas = self.kappas(&frames, kin, lu, mech.n);
-        let mut b = DMatrix::zeros(rows, columns.len());
+        let m = columns.len();
+        self.prepare(mech, pose, kin, lu, work);
+        let mut w = vec![0.0; rows];
+        let mut b = vec![0.0; rows * m];
         for (c, &p) in columns.iter().enumerate() {
-            let col = params.column(p);
-            for (i, w) in reg.wrench.iter().enumerate() {
-                let pi = &col[BODY_PARAMS * i..BODY_PARAMS * (i + 1)];
-                for r in 0..6 {
-                    b[(6 * i + r, c)] = (0..BODY_PARAMS).map(|x| w[r][x] * pi[x]).sum::<f64>();
-                }
-            }
-            for (s, slot) in params.springs.iter().enumerate() {
-                let off = BODY_PARAMS * l + crate::params::SPRING_PARAMS * s;
-                let x = &col[off..off + crate::params::SPRING_PARAMS];
-                let (fi, ni, fs, ns) = spring_wrenches(mech, pose, slot, x);
-                for r in 0..3 {
-                    b[(6 * slot.body + r, c)] -= fi[r];
-                    b[(6 * slot.body + 3 + r, c)] -= ni[r];
-                    if let Some(o) = slot.other {
-                        b[(6 * o + r, c)] -= fs[r];
-                        b[(6 * o + 3 + r, c)] -= ns[r];
-                    }
-                }
-            }
-            for (&(act, joint), &kappa) in self.actuated.iter().zip(&kappas) {
-                let j = &self.joints[joint];
-                let f = &frames[joint];
-                let tau = actuator_forces[c][act] / kappa;
-                for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
-                    if let BodyId::Body(bi) = j.bodies[side] {
-                        let (force, moment) = if j.kind == JointKind::Prismatic {
-                            let force = f.axis * (sign * tau);
-                            (force, (f.point - kin[bi].p).cross(&force))
-                        } else {
-                            (Vector3::zeros(), f.axis * (sign * tau))
-                        };
-                        for r in 0..3 {
-                            b[(6 * bi + r, c)] -= force[r];
-                            b[(6 * bi + 3 + r, c)] -= moment[r];
-                        }
-                    }
-                }
+            required_wrenches_with(mech, pose, &reg.wrench, params, p, &mut w);
+            self.subtract_actuators(work, kin, &actuator_forces[c], &mut w);
+            for (r, &x) in w.iter().enumerate() {
+                b[r * m + c] = x;
             }
         }
-        let lambda = self.min_norm_solve(&a, &b, kin, mech.n);
-        (0..columns.len())
+        let mut out = vec![0.0; 6 * self.joints.len() * m];
+        self.solve_prepared(work, &mut b, m, &mut out);
+        (0..m)
             .map(|c| {
-                let mut out = JointReactions::default();
-                for (j, f) in self.joints.iter().zip(&frames) {
-                    let mut force = Vector3::zeros();
-                    let mut moment = Vector3::zeros();
-                    let mut col = j.offset;
-                    for e in f.forces() {
-                        force += e * lambda[(col, c)];
-                        col += 1;
-                    }
-                    for e in f.moments() {
-                        moment += e * lambda[(col, c)];
-                        col += 1;
-                    }
-                    out.force.push(force);
-                    out.moment.push(moment);
+                let component = |j: usize, r: usize| out[(6 * j + r) * m + c];
+                JointReactions {
+                    force: (0..self.joints.len())
+                        .map(|j| Vector3::new(component(j, 0), component(j, 1), component(j, 2)))
+                        .collect(),
+                    moment: (0..self.joints.len())
+                        .map(|j| Vector3::new(component(j, 3), component(j, 4), component(j, 5)))
+                        .collect(),
                 }
-                out
             })
             .collect()
     }
@@ -630,27 +592,6 @@ impl ReactionSolver {
                 }
             }
         }
-    }
-
-    /// `λ = A⁺ b` for every column of `b`.
-    fn min_norm_solve(
-        &self,
-        a: &DMatrix<f64>,
-        b: &DMatrix<f64>,
-        kin: &[BodyKin],
-        n: usize,
-    ) -> DMatrix<f64> {
-        if self.fast {
-            let u = mobility_basis(kin, n);
-            let s = a * a.transpose() + &u * u.transpose();
-            if let Some(chol) = s.cholesky() {
-                return a.transpose() * chol.solve(b);
-            }
-        }
-        let svd = a.clone().svd(true, true);
-        let smax = svd.singular_values.max();
-        svd.solve(b, RANK_TOLERANCE * smax)
-            .unwrap_or_else(|_| DMatrix::zeros(a.ncols(), b.ncols()))
     }
 }
 

@@ -41,6 +41,7 @@ pub struct Workspace {
     scratch: Scratch,
     reg: SampleRegressor,
     view: SampleView,
+    reactions: crate::reactions::ReactionWork,
 }
 
 /// A compiled model ready to run moves.
@@ -227,6 +228,7 @@ impl<'m> Evaluator<'m> {
                 params,
                 columns,
                 &view.actuator_force,
+                &mut ws.reactions,
             );
             if view.reactions.iter().any(|r| {
                 r.force

@@ -1,6 +1,6 @@
 //! The palletizer against independent derivations: the Lagrangian by finite differences, the
-//! static actuator forces as ∂V/∂u, whole-mechanism balance of the joint reactions, and the
-//! time-reversal symmetry.
+//! static actuator forces as ∂V/∂u, whole-mechanism balance of the joint reactions, their
+//! minimum-norm property against an SVD null space, and the time-reversal symmetry.
 
 mod common;
 
@@ -223,6 +223,79 @@ fn reactions_balance_the_whole_mechanism() {
         );
         // a revolute joint carries no moment along its axis
         assert!(r.moment[j1].y.abs() < 1e-7 * scale);
+    }
+}
+
+/// The pantograph makes the reaction unknowns non-unique; the solver must return the
+/// minimum-norm set. A solution of `Aλ = b` has minimum norm exactly when it is orthogonal to
+/// the null space of `A` — here found by an SVD of the equations (8 self-equilibrated internal
+/// wrench sets), independently of the normal-equation factorisation the solver uses.
+#[test]
+fn reactions_are_the_minimum_norm_solution() {
+    use counterpoise_dynamics::mechanism::Scratch;
+    let model = case("palletizer");
+    let ev = Evaluator::new(&model).unwrap();
+    let params = ParameterSet::unbalanced(&model);
+    let mut rng = SplitMix64::new(23);
+    for _ in 0..4 {
+        let (q, qd, qdd) = random_state(&model, &mut rng);
+        let view = ev.at_state(&q, &qd, &qdd, &params, &[0], true).unwrap();
+        let reactions = &view.reactions[0];
+        let mut scratch = Scratch::default();
+        ev.mech.eval_poses(&q, &mut scratch);
+        let kin: Vec<_> = (0..ev.mech.body_count)
+            .map(|b| ev.mech.body_frame(&scratch.pose, b))
+            .collect();
+        let frames = ev.reactions.frames(&ev.mech, &scratch.pose);
+        let a = ev.reactions.matrix(&frames, &kin);
+        // λ in the solver's unknown order: per joint, the force then the moment components
+        // along the frame's directions (orthonormal within each group)
+        let lambda: Vec<f64> = frames
+            .iter()
+            .enumerate()
+            .flat_map(|(j, f)| {
+                let force = reactions.force[j];
+                let moment = reactions.moment[j];
+                f.forces()
+                    .iter()
+                    .map(move |e| e.dot(&force))
+                    .chain(f.moments().iter().map(move |e| e.dot(&moment)))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        assert_eq!(lambda.len(), a.ncols());
+        let lambda = DVector::from_vec(lambda);
+        // the directions span every component the joints carry: nothing is lost
+        let carried: f64 = reactions
+            .force
+            .iter()
+            .chain(&reactions.moment)
+            .map(|v| v.norm_squared())
+            .sum();
+        assert!((lambda.norm_squared() - carried).abs() < 1e-9 * carried);
+        // zero rows pad A to square so that the SVD returns the whole of V (nalgebra's is thin)
+        let mut square = nalgebra::DMatrix::zeros(a.ncols(), a.ncols());
+        square.rows_mut(0, a.nrows()).copy_from(&a);
+        let unknowns = a.ncols();
+        let svd = square.svd(false, true);
+        let v_t = svd.v_t.unwrap();
+        let smax = svd.singular_values.max();
+        let mut null_dims = 0;
+        for (k, &sigma) in svd.singular_values.iter().enumerate() {
+            if sigma > 1e-9 * smax {
+                continue;
+            }
+            null_dims += 1;
+            let along = v_t.row(k).transpose().dot(&lambda);
+            assert!(
+                along.abs() < 1e-9 * lambda.norm(),
+                "component {along} along a null direction (|λ| = {})",
+                lambda.norm()
+            );
+        }
+        // 53 unknowns, rank 45 (module doc of the reactions)
+        assert_eq!(null_dims + ev.reactions.rank, unknowns);
+        assert!(null_dims > 0);
     }
 }
 
