@@ -31,7 +31,9 @@ use rayon::prelude::*;
 
 use crate::error::{FailureReason, TaskFailure};
 use crate::indicators::StatsTable;
-use crate::kernel::{actuator_forces, required_wrenches, required_wrenches_with};
+use crate::kernel::{
+    ColumnBatch, actuator_forces, actuator_forces_batch, required_wrenches, required_wrenches_batch,
+};
 use crate::law::{quintic, quintic_move, sample_time};
 use crate::lu::SmallLu;
 use crate::mechanism::{BodyKin, Scratch};
@@ -49,6 +51,11 @@ struct Work {
     regressors: Vec<WrenchRegressor>,
     reactions_work: ReactionWork,
     w: Vec<f64>,
+    /// Required wrenches of a batch of columns, `[body row][column]`.
+    wb: Vec<f64>,
+    /// Actuator forces of a batch of columns, `[actuator][column]`.
+    qb: Vec<f64>,
+    lu_scratch: Vec<f64>,
     b: Vec<f64>,
     out: Vec<f64>,
     /// Motor torques at `Δ ∈ {0, 1, −1}`: `[Δ][actuator][column]`.
@@ -68,11 +75,13 @@ struct Work {
 /// Parameter columns grouped by their inertial parameters (see the module doc).
 struct InertiaGroups {
     /// Every column, in order.
-    all: Vec<usize>,
+    all: ColumnBatch,
     /// Per column, its group.
     group: Vec<usize>,
     /// Per group, its first column (the representative).
     reps: Vec<usize>,
+    /// The representatives as a batch.
+    rep_batch: ColumnBatch,
 }
 
 impl InertiaGroups {
@@ -92,9 +101,11 @@ impl InertiaGroups {
                 })
             })
             .collect();
+        let all: Vec<usize> = (0..params.len()).collect();
         InertiaGroups {
-            all: (0..params.len()).collect(),
+            all: ColumnBatch::new(params, &all),
             group,
+            rep_batch: ColumnBatch::new(params, &reps),
             reps,
         }
     }
@@ -478,10 +489,18 @@ fn sub_task(
                 qdd[a] -= bias[a];
             }
             lu.solve(&mut qdd);
-            let columns = if si == 0 { &groups.all } else { &groups.reps };
-            // With several columns, one wrench regressor per body serves them all; with one,
-            // the direct Newton–Euler wrench is cheaper.
-            let shared = columns.len() > 2;
+            let batch = if si == 0 {
+                &groups.all
+            } else {
+                &groups.rep_batch
+            };
+            let nc = batch.len();
+            // the batch's first right-hand side among those solved
+            let first = if si == 0 { 0 } else { cols + (si - 1) * nreps };
+            // With several columns, one wrench regressor per body serves them all and the
+            // columns are evaluated together; with one or two, the direct Newton–Euler wrench
+            // per column is cheaper.
+            let shared = nc > 2;
             work.regressors.clear();
             for (b, kin) in work.kin.iter_mut().enumerate() {
                 mech.set_motion(&pose, b, kin, &qd, &qdd);
@@ -489,35 +508,74 @@ fn sub_task(
                     work.regressors.push(wrench_regressor(kin, &mech.gravity));
                 }
             }
-            for (c, &p) in columns.iter().enumerate() {
-                if shared {
-                    required_wrenches_with(mech, &pose, &work.regressors, params, p, &mut work.w);
-                } else {
-                    required_wrenches(mech, &pose, &work.kin, params, p, &mut work.w);
-                }
-                let qu = actuator_forces(&work.kin, &work.w, n, &lu);
+            let mut store_torques = |c: usize, qu: &[f64; MAX_VARS]| {
                 for a in 0..n {
                     let torque = qu[a] * ev.ratios[a];
                     if si == 0 {
-                        work.torques[a * cols + p] = torque;
+                        work.torques[a * cols + c] = torque;
                     } else {
                         work.rep_torques[((si - 1) * n + a) * nreps + c] = torque;
                     }
                 }
+            };
+            if shared {
+                work.wb.resize(rows * nc, 0.0);
+                work.qb.resize(n * nc, 0.0);
+                required_wrenches_batch(
+                    mech,
+                    &pose,
+                    &work.regressors,
+                    &params.springs,
+                    batch,
+                    &mut work.wb,
+                );
+                actuator_forces_batch(
+                    &work.kin,
+                    &work.wb,
+                    nc,
+                    n,
+                    &lu,
+                    &mut work.qb,
+                    &mut work.lu_scratch,
+                );
+                for c in 0..nc {
+                    let mut qu = [0.0; MAX_VARS];
+                    for a in 0..n {
+                        qu[a] = work.qb[a * nc + c];
+                    }
+                    store_torques(c, &qu);
+                    if with_reactions {
+                        ev.reactions.subtract_actuators(
+                            &work.reactions_work,
+                            &work.kin,
+                            &qu,
+                            &mut work.wb[c..],
+                            nc,
+                        );
+                    }
+                }
                 if with_reactions {
-                    ev.reactions.subtract_actuators(
-                        &work.reactions_work,
-                        &work.kin,
-                        &qu,
-                        &mut work.w,
-                    );
-                    let col = if si == 0 {
-                        p
-                    } else {
-                        cols + (si - 1) * nreps + c
-                    };
                     for r in 0..rows {
-                        work.b[r * solved + col] = work.w[r];
+                        work.b[r * solved + first..r * solved + first + nc]
+                            .copy_from_slice(&work.wb[r * nc..(r + 1) * nc]);
+                    }
+                }
+            } else {
+                for (c, &p) in batch.columns.iter().enumerate() {
+                    required_wrenches(mech, &pose, &work.kin, params, p, &mut work.w);
+                    let qu = actuator_forces(&work.kin, &work.w, n, &lu);
+                    store_torques(c, &qu);
+                    if with_reactions {
+                        ev.reactions.subtract_actuators(
+                            &work.reactions_work,
+                            &work.kin,
+                            &qu,
+                            &mut work.w,
+                            1,
+                        );
+                        for r in 0..rows {
+                            work.b[r * solved + first + c] = work.w[r];
+                        }
                     }
                 }
             }

@@ -344,7 +344,7 @@ impl ReactionSolver {
         let mut b = vec![0.0; rows * m];
         for (c, &p) in columns.iter().enumerate() {
             required_wrenches_with(mech, pose, &reg.wrench, params, p, &mut w);
-            self.subtract_actuators(work, kin, &actuator_forces[c], &mut w);
+            self.subtract_actuators(work, kin, &actuator_forces[c], &mut w, 1);
             for (r, &x) in w.iter().enumerate() {
                 b[r * m + c] = x;
             }
@@ -507,13 +507,14 @@ impl ReactionSolver {
     }
 
     /// Subtracts the actuator wrenches of actuator forces `qu` from the right-hand side `b`
-    /// (one column, `6L`) of a prepared sample.
+    /// (one column of `6L` values `stride` apart) of a prepared sample.
     pub fn subtract_actuators(
         &self,
         work: &ReactionWork,
         kin: &[BodyKin],
         qu: &[f64],
         b: &mut [f64],
+        stride: usize,
     ) {
         for (&(act, joint), &kappa) in self.actuated.iter().zip(&work.kappas) {
             let j = &self.joints[joint];
@@ -525,12 +526,12 @@ impl ReactionSolver {
                         let force = f.axis * (sign * tau);
                         let moment = (f.point - kin[bi].p).cross(&force);
                         for r in 0..3 {
-                            b[6 * bi + r] -= force[r];
-                            b[6 * bi + 3 + r] -= moment[r];
+                            b[(6 * bi + r) * stride] -= force[r];
+                            b[(6 * bi + 3 + r) * stride] -= moment[r];
                         }
                     } else {
                         for r in 0..3 {
-                            b[6 * bi + 3 + r] -= sign * tau * f.axis[r];
+                            b[(6 * bi + 3 + r) * stride] -= sign * tau * f.axis[r];
                         }
                     }
                 }
