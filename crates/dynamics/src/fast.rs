@@ -82,6 +82,8 @@ struct InertiaGroups {
     reps: Vec<usize>,
     /// The representatives as a batch.
     rep_batch: ColumnBatch,
+    /// Per column, its representative.
+    rep_column: Vec<usize>,
 }
 
 impl InertiaGroups {
@@ -89,7 +91,7 @@ impl InertiaGroups {
         let inertial = crate::params::BODY_PARAMS * params.bodies;
         let mut index: HashMap<Vec<u64>, usize> = HashMap::new();
         let mut reps = Vec::new();
-        let group = (0..params.len())
+        let group: Vec<usize> = (0..params.len())
             .map(|p| {
                 let key = params.column(p)[..inertial]
                     .iter()
@@ -102,11 +104,33 @@ impl InertiaGroups {
             })
             .collect();
         let all: Vec<usize> = (0..params.len()).collect();
+        let rep_column = group.iter().map(|&g| reps[g]).collect();
         InertiaGroups {
+            rep_column,
             all: ColumnBatch::new(params, &all),
             group,
             rep_batch: ColumnBatch::new(params, &reps),
             reps,
+        }
+    }
+}
+
+impl InertiaGroups {
+    /// Every column's value from its representative's, `dst[p] = rep[g] + (zero[p] −
+    /// zero[r])` with `g` the column's group and `r` its representative, `zero` the values at
+    /// `Δ = 0`. When every column is its own group this is `rep` itself.
+    fn expand(&self, dst: &mut [f64], rep: &[f64], zero: &[f64]) {
+        if self.reps.len() == self.group.len() {
+            dst.copy_from_slice(rep);
+            return;
+        }
+        for (((d, &g), &r), &z) in dst
+            .iter_mut()
+            .zip(&self.group)
+            .zip(&self.rep_column)
+            .zip(zero)
+        {
+            *d = rep[g] + (z - zero[r]);
         }
     }
 }
@@ -598,10 +622,7 @@ fn sub_task(
                     let zero = &at_zero[a * cols..(a + 1) * cols];
                     let rep = &work.rep_torques[(si * n + a) * nreps..(si * n + a + 1) * nreps];
                     let dst = &mut at_pm[(si * n + a) * cols..(si * n + a + 1) * cols];
-                    for (p, v) in dst.iter_mut().enumerate() {
-                        let g = groups.group[p];
-                        *v = rep[g] + (zero[p] - zero[groups.reps[g]]);
-                    }
+                    groups.expand(dst, rep, zero);
                 }
             }
         }
@@ -609,13 +630,11 @@ fn sub_task(
             for row in 0..6 * nj {
                 let src = &work.out[row * solved..(row + 1) * solved];
                 let dst = &mut work.reactions[row * m..(row + 1) * m];
-                dst[..cols].copy_from_slice(&src[..cols]);
+                let zero = &src[..cols];
+                dst[..cols].copy_from_slice(zero);
                 for si in 0..2 {
                     let rep = &src[cols + si * nreps..cols + (si + 1) * nreps];
-                    for p in 0..cols {
-                        let g = groups.group[p];
-                        dst[(si + 1) * cols + p] = rep[g] + (src[p] - src[groups.reps[g]]);
-                    }
+                    groups.expand(&mut dst[(si + 1) * cols..(si + 2) * cols], rep, zero);
                 }
             }
         }
