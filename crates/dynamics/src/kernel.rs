@@ -58,20 +58,42 @@ pub fn required_wrenches(
         w[6 * i..6 * i + 3].copy_from_slice(f.as_slice());
         w[6 * i + 3..6 * i + 6].copy_from_slice(n.as_slice());
     }
-    for (s, slot) in params.springs.iter().enumerate() {
-        let off = BODY_PARAMS * l + SPRING_PARAMS * s;
-        let x = &col[off..off + SPRING_PARAMS];
-        if x.iter().all(|&v| v == 0.0) {
-            continue;
+    subtract_springs(mech, pose, &params.springs, &col[BODY_PARAMS * l..], w);
+}
+
+/// Subtracts the applied wrenches of a spring with lifted parameters `x` from required wrenches
+/// (row `r` of the column at `w[r · stride]`).
+fn subtract_spring(
+    mech: &Mechanism,
+    pose: &[f64],
+    slot: &SpringSlot,
+    x: &[f64],
+    w: &mut [f64],
+    stride: usize,
+) {
+    let (fi, ni, fs, ns) = spring_wrenches(mech, pose, slot, x);
+    for r in 0..3 {
+        w[(6 * slot.body + r) * stride] -= fi[r];
+        w[(6 * slot.body + 3 + r) * stride] -= ni[r];
+        if let Some(o) = slot.other {
+            w[(6 * o + r) * stride] -= fs[r];
+            w[(6 * o + 3 + r) * stride] -= ns[r];
         }
-        let (fi, ni, fs, ns) = spring_wrenches(mech, pose, slot, x);
-        for r in 0..3 {
-            w[6 * slot.body + r] -= fi[r];
-            w[6 * slot.body + 3 + r] -= ni[r];
-            if let Some(o) = slot.other {
-                w[6 * o + r] -= fs[r];
-                w[6 * o + 3 + r] -= ns[r];
-            }
+    }
+}
+
+/// Subtracts every spring of one column (`springs`: its lifted spring parameters, slot after
+/// slot) from its required wrenches `w`.
+fn subtract_springs(
+    mech: &Mechanism,
+    pose: &[f64],
+    slots: &[SpringSlot],
+    springs: &[f64],
+    w: &mut [f64],
+) {
+    for (slot, x) in slots.iter().zip(springs.chunks_exact(SPRING_PARAMS)) {
+        if x.iter().any(|&v| v != 0.0) {
+            subtract_spring(mech, pose, slot, x, w, 1);
         }
     }
 }
@@ -98,22 +120,7 @@ pub fn required_wrenches_with(
             w[6 * i + r] = acc;
         }
     }
-    for (s, slot) in params.springs.iter().enumerate() {
-        let off = BODY_PARAMS * l + SPRING_PARAMS * s;
-        let x = &col[off..off + SPRING_PARAMS];
-        if x.iter().all(|&v| v == 0.0) {
-            continue;
-        }
-        let (fi, ni, fs, ns) = spring_wrenches(mech, pose, slot, x);
-        for r in 0..3 {
-            w[6 * slot.body + r] -= fi[r];
-            w[6 * slot.body + 3 + r] -= ni[r];
-            if let Some(o) = slot.other {
-                w[6 * o + r] -= fs[r];
-                w[6 * o + 3 + r] -= ns[r];
-            }
-        }
-    }
+    subtract_springs(mech, pose, &params.springs, &col[BODY_PARAMS * l..], w);
 }
 
 /// `Q_q = Σ_i J_v,iᵀ F_i + J_ω,iᵀ N_i`, then `Q_u = G⁻ᵀ Q_q` (returned).
@@ -274,16 +281,7 @@ pub fn required_wrenches_batch(
     }
     for (p, springs) in batch.springs.iter().enumerate() {
         for (s, x) in springs {
-            let slot = &slots[*s];
-            let (fi, ni, fs, ns) = spring_wrenches(mech, pose, slot, x);
-            for r in 0..3 {
-                w[(6 * slot.body + r) * nc + p] -= fi[r];
-                w[(6 * slot.body + 3 + r) * nc + p] -= ni[r];
-                if let Some(o) = slot.other {
-                    w[(6 * o + r) * nc + p] -= fs[r];
-                    w[(6 * o + 3 + r) * nc + p] -= ns[r];
-                }
-            }
+            subtract_spring(mech, pose, &slots[*s], x, &mut w[p..], nc);
         }
     }
 }
