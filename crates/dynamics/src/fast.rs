@@ -113,9 +113,7 @@ impl InertiaGroups {
             reps,
         }
     }
-}
 
-impl InertiaGroups {
     /// Every column's value from its representative's, `dst[p] = rep[g] + (zero[p] −
     /// zero[r])` with `g` the column's group and `r` its representative, `zero` the values at
     /// `Δ = 0`. When every column is its own group this is `rep` itself.
