@@ -652,17 +652,14 @@ fn cholesky_upper_in_place(s: &mut [f64], n: usize, stride: usize) -> bool {
                 .zip(r2[from..].chunks_exact(LANE))
                 .zip(r3[from..].chunks_exact(LANE))
             {
-                let v: &mut [f64; LANE] = v.try_into().expect("whole lane");
-                let (a, b): (&[f64; LANE], &[f64; LANE]) = (a.try_into().expect("lane"), b.try_into().expect("lane"));
-                let (c, d): (&[f64; LANE], &[f64; LANE]) = (c.try_into().expect("lane"), d.try_into().expect("lane"));
                 // Copies in registers: the compiler cannot see that `v` and the rows above
                 // do not overlap and would otherwise keep the lane loop scalar.
-                let (a, b, c, d) = (*a, *b, *c, *d);
-                let mut acc = *v;
+                let (a, b, c, d) = (lane(a), lane(b), lane(c), lane(d));
+                let mut acc = lane(v);
                 for i in 0..LANE {
                     acc[i] -= (x0 * a[i] + x1 * b[i]) + (x2 * c[i] + x3 * d[i]);
                 }
-                *v = acc;
+                v.copy_from_slice(&acc);
             }
         }
         for row_k in tail.chunks_exact(stride) {
@@ -671,14 +668,12 @@ fn cholesky_upper_in_place(s: &mut [f64], n: usize, stride: usize) -> bool {
                 .chunks_exact_mut(LANE)
                 .zip(row_k[from..].chunks_exact(LANE))
             {
-                let v: &mut [f64; LANE] = v.try_into().expect("whole lane");
-                let y: &[f64; LANE] = y.try_into().expect("whole lane");
-                let y = *y;
-                let mut acc = *v;
+                let y = lane(y);
+                let mut acc = lane(v);
                 for i in 0..LANE {
                     acc[i] -= x * y[i];
                 }
-                *v = acc;
+                v.copy_from_slice(&acc);
             }
         }
         let row_j = &mut row_j[j - from..n - from];
@@ -699,6 +694,12 @@ fn cholesky_upper_in_place(s: &mut [f64], n: usize, stride: usize) -> bool {
 
 /// Lane width of the padded factor rows.
 const LANE: usize = 8;
+
+/// A copy of one whole lane (`s` has exactly [`LANE`] values).
+#[inline(always)]
+fn lane(s: &[f64]) -> [f64; LANE] {
+    s.try_into().expect("a whole lane")
+}
 
 /// `n` rounded up to whole lanes.
 fn padded(n: usize) -> usize {
