@@ -78,9 +78,7 @@ struct InertiaGroups {
     all: ColumnBatch,
     /// Per column, its group.
     group: Vec<usize>,
-    /// Per group, its first column (the representative).
-    reps: Vec<usize>,
-    /// The representatives as a batch.
+    /// Per group, its first column (the representative), as a batch.
     rep_batch: ColumnBatch,
     /// Per column, its representative.
     rep_column: Vec<usize>,
@@ -110,7 +108,6 @@ impl InertiaGroups {
             all: ColumnBatch::new(params, &all),
             group,
             rep_batch: ColumnBatch::new(params, &reps),
-            reps,
         }
     }
 
@@ -118,7 +115,7 @@ impl InertiaGroups {
     /// zero[r])` with `g` the column's group and `r` its representative, `zero` the values at
     /// `Δ = 0`. When every column is its own group this is `rep` itself.
     fn expand(&self, dst: &mut [f64], rep: &[f64], zero: &[f64]) {
-        if self.reps.len() == self.group.len() {
+        if self.rep_batch.len() == self.group.len() {
             dst.copy_from_slice(rep);
             return;
         }
@@ -461,7 +458,7 @@ fn sub_task(
     let m = 3 * cols;
     let tq = n * cols;
     let rq = 2 * nj * cols;
-    let nreps = groups.reps.len();
+    let nreps = groups.rep_batch.len();
     // right-hand sides solved: every column at Δ = 0, the representatives at Δ = ±1
     let solved = cols + 2 * nreps;
     work.coefficients.resize(ns * stride, 0.0);
