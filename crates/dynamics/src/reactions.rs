@@ -720,6 +720,16 @@ fn axpy(acc: &mut [f64; LANE], x: f64, v: &Lanes) {
     }
 }
 
+/// The four partial sums of [`combo`] and [`sparse_combo`] added in a fixed order.
+#[inline(always)]
+fn sum_partials(s: &[[f64; LANE]; 4]) -> [f64; LANE] {
+    let mut out = [0.0; LANE];
+    for p in 0..LANE {
+        out[p] = (s[0][p] + s[1][p]) + (s[2][p] + s[3][p]);
+    }
+    out
+}
+
 /// `Σ_j w[j] · v[j]` over all lanes with four interleaved partial sums (independent
 /// dependency chains; fixed order).
 #[inline(always)]
@@ -737,11 +747,7 @@ fn combo(w: &[f64], v: &[Lanes]) -> [f64; LANE] {
     for (k, &x) in rem.iter().enumerate() {
         axpy(&mut s[k], x, &v[tail + k]);
     }
-    let mut out = [0.0; LANE];
-    for p in 0..LANE {
-        out[p] = (s[0][p] + s[1][p]) + (s[2][p] + s[3][p]);
-    }
-    out
+    sum_partials(&s)
 }
 
 /// `Σ_r w[r] · v[r]` over the rows `r` in `rows`, with the interleaved partial sums of
@@ -760,11 +766,7 @@ fn sparse_combo(w: &[f64], rows: &[usize], v: &[Lanes]) -> [f64; LANE] {
     for (k, &r) in rem.iter().enumerate() {
         axpy(&mut s[k], w[r], &v[r]);
     }
-    let mut out = [0.0; LANE];
-    for p in 0..LANE {
-        out[p] = (s[0][p] + s[1][p]) + (s[2][p] + s[3][p]);
-    }
-    out
+    sum_partials(&s)
 }
 
 /// Scratch of [`chunk_solve`]: one row of lanes per equation.
