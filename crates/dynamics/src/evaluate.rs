@@ -50,6 +50,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{DynamicsError, TaskFailure};
 use crate::indicators::{Indicators, StatsTable, TaskStats, reduce};
 use crate::params::ParameterSet;
+use crate::reactions::JointReactions;
 use crate::runner::{Evaluator, Workspace};
 use crate::tasks::TaskSet;
 
@@ -281,6 +282,32 @@ pub struct JointSeries {
     pub moment: Vec<f64>,
 }
 
+impl JointSeries {
+    /// One empty series per joint of the evaluator's model.
+    pub(crate) fn for_joints(ev: &Evaluator) -> Vec<JointSeries> {
+        ev.joint_names()
+            .into_iter()
+            .map(|name| JointSeries {
+                name,
+                force: Vec::new(),
+                moment: Vec::new(),
+            })
+            .collect()
+    }
+
+    /// Appends one sample's reaction magnitudes to every joint's series.
+    pub(crate) fn record(series: &mut [JointSeries], reactions: &JointReactions) {
+        for (js, (f, m)) in series.iter_mut().zip(
+            reactions
+                .force_magnitudes()
+                .zip(reactions.moment_magnitudes()),
+        ) {
+            js.force.push(f);
+            js.moment.push(m);
+        }
+    }
+}
+
 /// The time series of one task (see the module doc).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Series {
@@ -332,15 +359,7 @@ pub fn task_series_with(
         q: Vec::new(),
         actuator_force: Vec::new(),
         motor_torque: Vec::new(),
-        joints: ev
-            .joint_names()
-            .into_iter()
-            .map(|name| JointSeries {
-                name,
-                force: Vec::new(),
-                moment: Vec::new(),
-            })
-            .collect(),
+        joints: JointSeries::for_joints(&ev),
         reactions_minimum_norm: ev.reactions.minimum_norm,
     };
     let mut ws = Workspace::default();
@@ -362,15 +381,7 @@ pub fn task_series_with(
                 .actuator_force
                 .push(view.actuator_force[0][..n].to_vec());
             series.motor_torque.push(view.motor_torque[0][..n].to_vec());
-            let r = &view.reactions[0];
-            for (js, (f, m)) in series
-                .joints
-                .iter_mut()
-                .zip(r.force_magnitudes().zip(r.moment_magnitudes()))
-            {
-                js.force.push(f);
-                js.moment.push(m);
-            }
+            JointSeries::record(&mut series.joints, &view.reactions[0]);
         },
     )
     .map_err(|(_, reason)| DynamicsError::TaskFailed(reason))?;

@@ -91,15 +91,7 @@ pub fn path_series(
         q: Vec::new(),
         actuator_force: Vec::new(),
         motor_torque: Vec::new(),
-        joints: ev
-            .joint_names()
-            .into_iter()
-            .map(|name| JointSeries {
-                name,
-                force: Vec::new(),
-                moment: Vec::new(),
-            })
-            .collect(),
+        joints: JointSeries::for_joints(&ev),
         carried: Vec::new(),
         stats: TaskStats::default(),
         rms: Vec::new(),
@@ -140,14 +132,7 @@ pub fn path_series(
                 out.motor_torque.push(view.motor_torque[0][..n].to_vec());
                 out.carried.push(on);
                 let r = &view.reactions[0];
-                for (js, (f, m)) in out
-                    .joints
-                    .iter_mut()
-                    .zip(r.force_magnitudes().zip(r.moment_magnitudes()))
-                {
-                    js.force.push(f);
-                    js.moment.push(m);
-                }
+                JointSeries::record(&mut out.joints, r);
                 acc.add_torques(&view.motor_torque[0][..n]);
                 acc.add_reactions(r.force_magnitudes(), r.moment_magnitudes());
             },
