@@ -155,15 +155,7 @@ pub fn optimise_all(
         if evaluated.is_empty() {
             continue;
         }
-        let dyn_variants: Vec<Variant> = evaluated
-            .iter()
-            .map(|&k| {
-                dynamics_variant(
-                    runs[k].problem.as_ref().expect("problem"),
-                    runs[k].candidate.as_ref().expect("candidate"),
-                )
-            })
-            .collect();
+        let dyn_variants = candidate_variants(&runs, &evaluated);
         let indicators = match grid_indicators(ctx, &dyn_variants, false) {
             Ok(i) => i,
             Err(e) => {
@@ -393,6 +385,19 @@ fn step(
         relaxation_iterations: relaxed.solution.iterations,
         gap_before,
     })
+}
+
+/// The dynamics variants of the current candidates of runs `ks` (each has a problem and a
+/// candidate).
+fn candidate_variants(runs: &[Run], ks: &[usize]) -> Vec<Variant> {
+    ks.iter()
+        .map(|&k| {
+            dynamics_variant(
+                runs[k].problem.as_ref().expect("problem"),
+                runs[k].candidate.as_ref().expect("candidate"),
+            )
+        })
+        .collect()
 }
 
 fn dynamics_variant(problem: &VariantProblem, c: &Candidate) -> Variant {
@@ -716,15 +721,7 @@ fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<O
                 && matches!(runs[k].state, State::Converged | State::Stopped)
         })
         .collect();
-    let variants: Vec<Variant> = finals
-        .iter()
-        .map(|&k| {
-            dynamics_variant(
-                runs[k].problem.as_ref().expect("problem"),
-                runs[k].candidate.as_ref().expect("candidate"),
-            )
-        })
-        .collect();
+    let variants = candidate_variants(&runs, &finals);
     let final_indicators = if variants.is_empty() {
         Ok(Vec::new())
     } else {
