@@ -12,6 +12,7 @@
 
 pub mod case;
 pub mod error;
+pub mod exact;
 mod joints;
 pub mod kinematics;
 pub mod model;
@@ -24,6 +25,7 @@ use std::path::Path;
 
 pub use case::Case;
 pub use error::{CaseErrors, ModelError};
+pub use exact::{ExactFrame, ExactMechanism, NotExact, exact_mechanism};
 pub use kinematics::{BodyJacobian, BodyMotion, Kinematics, Pose};
 pub use model::{
     Actuator, ActuatorMap, Balancing, Body, BodyId, Bounds, Coordinate, CounterweightOptions,

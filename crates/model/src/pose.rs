@@ -4,44 +4,49 @@
 //! Rotation angles must be integer combinations of angle coordinates plus a constant (so the
 //! rotation stays a trigonometric polynomial); translations may be any trigonometric polynomial.
 
-use counterpoise_symbolic::{ExprContext, LinearAngle, PolyMat3, PolyVec3, TrigPoly};
+use counterpoise_symbolic::{Context, Field, Mat3, Poly, TrigPoly, Vec3};
 
 use crate::case::{Expr, PoseStep};
 use crate::error::ModelError;
 
-/// A rigid transform `x ↦ R x + p` with polynomial entries.
+/// A rigid transform `x ↦ R x + p` with polynomial entries over the field `C`.
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) struct PolyPose {
-    pub rotation: PolyMat3,
-    pub origin: PolyVec3,
+pub(crate) struct SymbolicPose<C> {
+    pub rotation: Mat3<C>,
+    pub origin: Vec3<C>,
 }
 
-impl PolyPose {
-    pub fn identity() -> PolyPose {
-        PolyPose {
-            rotation: PolyMat3::identity(),
-            origin: PolyVec3::zero(),
+/// The numeric pose the model is built from.
+pub(crate) type PolyPose = SymbolicPose<f64>;
+
+impl<C: Field> SymbolicPose<C> {
+    pub fn identity() -> Self {
+        SymbolicPose {
+            rotation: Mat3::identity(),
+            origin: Vec3::zero(),
         }
     }
 
     /// `self · (translation t)`.
-    fn translate(&mut self, t: &PolyVec3) {
+    fn translate(&mut self, t: &Vec3<C>) {
         self.origin = self.origin.add(&self.rotation.mul_vec(t));
     }
 
     /// `self · (rotation r)`.
-    fn rotate(&mut self, r: &PolyMat3) {
+    fn rotate(&mut self, r: &Mat3<C>) {
         self.rotation = self.rotation.mul_mat(r);
     }
 
     /// `self · other`.
-    pub fn compose(&self, other: &PolyPose) -> PolyPose {
-        PolyPose {
+    pub fn compose(&self, other: &Self) -> Self {
+        SymbolicPose {
             rotation: self.rotation.mul_mat(&other.rotation),
             origin: self.origin.add(&self.rotation.mul_vec(&other.origin)),
         }
     }
+}
 
+impl PolyPose {
     /// Drops coefficients that are floating-point noise (e.g. `cos(pi/2) ≈ 6e-17`), so that
     /// coefficient maps stay sparse and exact-zero tests on energies are meaningful.
     pub fn prune(&mut self) {
@@ -58,15 +63,24 @@ impl PolyPose {
     }
 }
 
-/// Parses expressions of one case file, attaching JSON paths to the errors.
-pub(crate) struct Parser<'a> {
-    pub context: &'a ExprContext,
+/// Parses expressions of one case file, attaching JSON paths to the errors. Lowers a case's expressions and pose steps over the field `F` (`f64` for the model, exact
+/// rationals for the balance decision).
+pub(crate) struct Parser<'a, F: Field = f64> {
+    pub context: &'a Context<F>,
 }
 
-impl Parser<'_> {
-    pub fn poly(&self, expr: &Expr, path: &str) -> Result<TrigPoly, ModelError> {
+/// A literal number of the case file as a constant of `F`.
+fn literal<F: Field>(x: f64, path: &str) -> Result<F::Constant, ModelError> {
+    F::literal(x).map_err(|reason| ModelError::invalid(path, reason))
+}
+
+impl<F: Field> Parser<'_, F> {
+    pub fn poly(&self, expr: &Expr, path: &str) -> Result<Poly<F>, ModelError> {
         let poly = match expr {
-            Expr::Number(x) => TrigPoly::constant(*x),
+            Expr::Number(x) => Poly::constant(
+                F::to_scalar(&literal::<F>(*x, path)?)
+                    .map_err(|reason| ModelError::invalid(path, reason))?,
+            ),
             Expr::Text(s) => {
                 self.context
                     .parse_poly(s)
@@ -76,33 +90,41 @@ impl Parser<'_> {
                     })?
             }
         };
-        if poly.terms().any(|(_, c)| !c.is_finite()) {
+        if poly.terms_ref().any(|(_, c)| !c.to_f64().is_finite()) {
             return Err(ModelError::invalid(path, "expression is not finite"));
         }
         Ok(poly)
     }
 
-    pub fn angle(&self, expr: &Expr, path: &str) -> Result<LinearAngle, ModelError> {
-        let angle = match expr {
-            Expr::Number(x) => LinearAngle::constant(*x),
-            Expr::Text(s) => {
+    /// `(cos φ, sin φ)` of a rotation angle `φ`.
+    pub fn cos_sin(&self, expr: &Expr, path: &str) -> Result<(Poly<F>, Poly<F>), ModelError> {
+        let (c, s) = match expr {
+            Expr::Number(x) => {
+                let (c, s) = F::cos_sin(&literal::<F>(*x, path)?)
+                    .map_err(|reason| ModelError::invalid(path, reason))?;
+                (Poly::constant(c), Poly::constant(s))
+            }
+            Expr::Text(src) => {
                 self.context
-                    .parse_angle(s)
+                    .parse_cos_sin(src)
                     .map_err(|source| ModelError::Expression {
                         path: path.to_string(),
                         source,
                     })?
             }
         };
-        if !angle.offset.is_finite() {
+        if c.terms_ref()
+            .chain(s.terms_ref())
+            .any(|(_, v)| !v.to_f64().is_finite())
+        {
             return Err(ModelError::invalid(path, "angle is not finite"));
         }
-        Ok(angle)
+        Ok((c, s))
     }
 
-    pub fn constant(&self, expr: &Expr, path: &str) -> Result<f64, ModelError> {
+    pub fn constant(&self, expr: &Expr, path: &str) -> Result<F::Constant, ModelError> {
         let value = match expr {
-            Expr::Number(x) => *x,
+            Expr::Number(x) => literal::<F>(*x, path)?,
             Expr::Text(s) => {
                 self.context
                     .parse_constant(s)
@@ -112,10 +134,11 @@ impl Parser<'_> {
                     })?
             }
         };
-        if !value.is_finite() {
+        let number = F::constant_value(&value);
+        if !number.is_finite() {
             return Err(ModelError::invalid(
                 path,
-                format!("value {value} is not finite"),
+                format!("value {number} is not finite"),
             ));
         }
         Ok(value)
@@ -127,8 +150,8 @@ impl Parser<'_> {
         exprs: &[Expr; 3],
         path: &str,
         errors: &mut Vec<ModelError>,
-    ) -> Option<[f64; 3]> {
-        let mut out = [0.0; 3];
+    ) -> Option<[F::Constant; 3]> {
+        let mut out = [F::zero_constant(), F::zero_constant(), F::zero_constant()];
         let mut ok = true;
         for (k, e) in exprs.iter().enumerate() {
             match self.constant(e, &format!("{path}[{k}]")) {
@@ -149,8 +172,8 @@ impl Parser<'_> {
         steps: &[PoseStep],
         path: &str,
         errors: &mut Vec<ModelError>,
-    ) -> Option<PolyPose> {
-        let mut pose = PolyPose::identity();
+    ) -> Option<SymbolicPose<F>> {
+        let mut pose = SymbolicPose::identity();
         let mut ok = true;
         for (n, step) in steps.iter().enumerate() {
             let step_path = format!("{path}[{n}]");
@@ -159,21 +182,18 @@ impl Parser<'_> {
                 ok = false;
             }
         }
-        ok.then(|| {
-            pose.prune();
-            pose
-        })
+        ok.then_some(pose)
     }
 
     fn apply_step(
         &self,
-        pose: &mut PolyPose,
+        pose: &mut SymbolicPose<F>,
         step: &PoseStep,
         path: &str,
     ) -> Result<(), Vec<ModelError>> {
         match step {
             PoseStep::Translate(t) => {
-                let mut entries: [TrigPoly; 3] = Default::default();
+                let mut entries: [Poly<F>; 3] = Default::default();
                 let mut errors = Vec::new();
                 for (k, e) in t.iter().enumerate() {
                     match self.poly(e, &format!("{path}.translate[{k}]")) {
@@ -184,37 +204,37 @@ impl Parser<'_> {
                 if !errors.is_empty() {
                     return Err(errors);
                 }
-                pose.translate(&PolyVec3(entries));
+                pose.translate(&Vec3(entries));
             }
             PoseStep::RotX(e) => {
-                let a = self
-                    .angle(e, &format!("{path}.rot_x"))
+                let (c, s) = self
+                    .cos_sin(e, &format!("{path}.rot_x"))
                     .map_err(|e| vec![e])?;
-                pose.rotate(&PolyMat3::rot_x(&a));
+                pose.rotate(&Mat3::rot_x_cs(c, s));
             }
             PoseStep::RotY(e) => {
-                let a = self
-                    .angle(e, &format!("{path}.rot_y"))
+                let (c, s) = self
+                    .cos_sin(e, &format!("{path}.rot_y"))
                     .map_err(|e| vec![e])?;
-                pose.rotate(&PolyMat3::rot_y(&a));
+                pose.rotate(&Mat3::rot_y_cs(c, s));
             }
             PoseStep::RotZ(e) => {
-                let a = self
-                    .angle(e, &format!("{path}.rot_z"))
+                let (c, s) = self
+                    .cos_sin(e, &format!("{path}.rot_z"))
                     .map_err(|e| vec![e])?;
-                pose.rotate(&PolyMat3::rot_z(&a));
+                pose.rotate(&Mat3::rot_z_cs(c, s));
             }
             PoseStep::Dh(dh) => {
-                let theta = self.angle(&dh.theta, &format!("{path}.dh.theta"));
+                let theta = self.cos_sin(&dh.theta, &format!("{path}.dh.theta"));
                 let d = self.poly(&dh.d, &format!("{path}.dh.d"));
                 let a = self.poly(&dh.a, &format!("{path}.dh.a"));
-                let alpha = self.angle(&dh.alpha, &format!("{path}.dh.alpha"));
+                let alpha = self.cos_sin(&dh.alpha, &format!("{path}.dh.alpha"));
                 match (theta, d, a, alpha) {
-                    (Ok(theta), Ok(d), Ok(a), Ok(alpha)) => {
+                    (Ok((ct, st)), Ok(d), Ok(a), Ok((ca, sa))) => {
                         // Rz(theta)·Tz(d)·Tx(a)·Rx(alpha)
-                        pose.rotate(&PolyMat3::rot_z(&theta));
-                        pose.translate(&PolyVec3([a, TrigPoly::zero(), d]));
-                        pose.rotate(&PolyMat3::rot_x(&alpha));
+                        pose.rotate(&Mat3::rot_z_cs(ct, st));
+                        pose.translate(&Vec3([a, Poly::zero(), d]));
+                        pose.rotate(&Mat3::rot_x_cs(ca, sa));
                     }
                     (theta, d, a, alpha) => {
                         let mut errors = Vec::new();

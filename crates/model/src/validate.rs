@@ -284,7 +284,11 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
     let mut inertial = Vec::new();
     for (i, b) in case.bodies.iter().enumerate() {
         let path = format!("bodies[{i}]");
-        relative.push(parser.pose(&b.pose, &format!("{path}.pose"), &mut v.errors));
+        let pose = parser.pose(&b.pose, &format!("{path}.pose"), &mut v.errors);
+        relative.push(pose.map(|mut p| {
+            p.prune();
+            p
+        }));
         v.non_negative(b.mass, &format!("{path}.mass"));
         let com = match &b.com {
             Some(e) => parser

@@ -3,7 +3,8 @@
 //! Only these angles keep a rotation a trigonometric polynomial: `cos(2θ₁ − θ₂ + c)` expands into
 //! products of `cos θ_k`, `sin θ_k`, while `cos(θ/2)` or `cos(θ₁θ₂)` do not.
 
-use crate::poly::TrigPoly;
+use crate::poly::{Poly, TrigPoly};
+use crate::scalar::Scalar;
 
 /// `Σ n_k θ_k + offset` with integer `n_k`.
 #[derive(Clone, Debug, PartialEq, Default)]
@@ -34,14 +35,21 @@ impl LinearAngle {
     /// `(cos φ, sin φ)` as trigonometric polynomials, from `e^{iφ} = e^{i·offset} Π (c_k + i s_k)^{n_k}`.
     pub fn cos_sin(&self) -> (TrigPoly, TrigPoly) {
         let (s0, c0) = self.offset.sin_cos();
-        let mut re = TrigPoly::constant(c0);
-        let mut im = TrigPoly::constant(s0);
+        self.expand(c0, s0)
+    }
+
+    /// `(cos φ, sin φ)` with the constant part's cosine and sine given in the field `C` (exact
+    /// rationals when the constant is a multiple of π/2 or a rational rotation), the offset
+    /// field itself ignored.
+    pub fn expand<C: Scalar>(&self, cos_offset: C, sin_offset: C) -> (Poly<C>, Poly<C>) {
+        let mut re = Poly::constant(cos_offset);
+        let mut im = Poly::constant(sin_offset);
         for &(var, n) in &self.terms {
-            let unit_re = TrigPoly::cos(var);
+            let unit_re = Poly::<C>::cos(var);
             let unit_im = if n < 0 {
-                -TrigPoly::sin(var)
+                -Poly::<C>::sin(var)
             } else {
-                TrigPoly::sin(var)
+                Poly::<C>::sin(var)
             };
             for _ in 0..n.unsigned_abs() {
                 let next_re = &(&re * &unit_re) - &(&im * &unit_im);

@@ -3,16 +3,24 @@
 //! Grammar: numbers, parameter and coordinate names, `pi`, binary `+ - * /`, `^` with a
 //! non-negative integer exponent, unary minus, parentheses, and `cos(..)`, `sin(..)` of an angle
 //! expression. Everything a trigonometric polynomial cannot hold is refused with the offending
-//! part named: other functions (`sqrt`, `atan2`), division by anything that is not constant
+//! part named: other functions (`sqrt`, `atan2` of coordinates), division by anything that is not constant
 //! (`1/th2`), non-integer or negative powers, bare angles outside `cos`/`sin`, and `cos`/`sin` of
 //! anything but an integer combination of angle coordinates plus a constant (`cos(th1*th2)`,
 //! `cos(th1/2)`).
+//!
+//! `atan2(y, x)` of constants names a constant angle; with rational `x`, `y` and a rational
+//! hypotenuse (`atan2(4, 3)`: cosine 3/5, sine 4/5) the rotation it makes stays exact.
+//!
+//! Lowering is generic over the coefficient [`Field`]: the same code builds the numeric
+//! polynomials and, for the balance decision, the exact ones.
 
 use std::collections::BTreeMap;
 
 use crate::angle::LinearAngle;
+use crate::field::Field;
 use crate::monomial::VarKind;
-use crate::poly::TrigPoly;
+use crate::poly::Poly;
+use crate::scalar::Rational;
 
 /// Why an expression was refused: the whole expression, the offending part and the reason.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -23,16 +31,35 @@ pub struct ExprError {
     pub reason: String,
 }
 
-/// Names known to expressions: numeric parameters and the chart coordinates (index = position).
-#[derive(Clone, Debug, Default)]
-pub struct ExprContext {
-    parameters: BTreeMap<String, f64>,
+/// Names known to expressions: parameters and the chart coordinates (index = position), over
+/// the coefficient field `F` ([`ExprContext`] for `f64`, [`ExactContext`] for exact rationals).
+#[derive(Clone, Debug)]
+pub struct Context<F: Field> {
+    parameters: BTreeMap<String, F::Constant>,
     coordinates: Vec<(String, VarKind)>,
 }
 
-impl ExprContext {
-    pub fn new(parameters: BTreeMap<String, f64>, coordinates: Vec<(String, VarKind)>) -> Self {
-        ExprContext {
+/// The numeric expression context (the model's workhorse).
+pub type ExprContext = Context<f64>;
+/// The exact expression context: numbers are the decimals written, `pi` and `atan2` are tracked
+/// symbolically, and anything irrational outside a rotation angle is refused as not exact.
+pub type ExactContext = Context<Rational>;
+
+impl<F: Field> Default for Context<F> {
+    fn default() -> Self {
+        Context {
+            parameters: BTreeMap::new(),
+            coordinates: Vec::new(),
+        }
+    }
+}
+
+impl<F: Field> Context<F> {
+    pub fn new(
+        parameters: BTreeMap<String, F::Constant>,
+        coordinates: Vec<(String, VarKind)>,
+    ) -> Self {
+        Context {
             parameters,
             coordinates,
         }
@@ -43,11 +70,13 @@ impl ExprContext {
     }
 
     /// Parses an expression that must be a trigonometric polynomial in the coordinates.
-    pub fn parse_poly(&self, src: &str) -> Result<TrigPoly, ExprError> {
+    pub fn parse_poly(&self, src: &str) -> Result<Poly<F>, ExprError> {
         let (ast, span) = self.parse(src)?;
         match self.lower(src, &ast)? {
             Value::Poly(p) => Ok(p),
-            Value::Affine(a) if a.angles.is_empty() => Ok(TrigPoly::constant(a.constant)),
+            Value::Affine(a) if a.angles.is_empty() => Ok(Poly::constant(
+                F::to_scalar(&a.constant).map_err(|reason| error(src, span, &reason))?,
+            )),
             Value::Affine(_) => Err(error(
                 src,
                 span,
@@ -56,19 +85,31 @@ impl ExprContext {
         }
     }
 
-    /// Parses an angle: an integer combination of angle coordinates plus a constant.
-    pub fn parse_angle(&self, src: &str) -> Result<LinearAngle, ExprError> {
+    /// Parses an angle: integer multiples of angle coordinates (sorted by index) and a constant.
+    pub fn parse_angle_parts(
+        &self,
+        src: &str,
+    ) -> Result<(Vec<(usize, i32)>, F::Constant), ExprError> {
         let (ast, span) = self.parse(src)?;
         let value = self.lower(src, &ast)?;
         to_angle(src, span, value)
     }
 
+    /// `(cos φ, sin φ)` of an angle expression `φ`, as polynomials over `F`.
+    pub fn parse_cos_sin(&self, src: &str) -> Result<(Poly<F>, Poly<F>), ExprError> {
+        let (ast, span) = self.parse(src)?;
+        let value = self.lower(src, &ast)?;
+        let (terms, constant) = to_angle(src, span, value)?;
+        let (c0, s0) = F::cos_sin(&constant).map_err(|reason| error(src, span, &reason))?;
+        Ok(LinearAngle { terms, offset: 0.0 }.expand(c0, s0))
+    }
+
     /// Parses an expression that must not depend on any coordinate.
-    pub fn parse_constant(&self, src: &str) -> Result<f64, ExprError> {
+    pub fn parse_constant(&self, src: &str) -> Result<F::Constant, ExprError> {
         let (ast, span) = self.parse(src)?;
         match self.lower(src, &ast)? {
             Value::Affine(a) if a.angles.is_empty() => Ok(a.constant),
-            Value::Poly(p) if p.is_constant() => Ok(p.constant_term()),
+            Value::Poly(p) if p.is_constant() => Ok(F::from_scalar(p.constant_term())),
             _ => Err(error(src, span, "must be a constant (no coordinates)")),
         }
     }
@@ -88,32 +129,36 @@ impl ExprContext {
         Ok((node, span))
     }
 
-    fn lower(&self, src: &str, node: &Node) -> Result<Value, ExprError> {
+    fn lower(&self, src: &str, node: &Node) -> Result<Value<F>, ExprError> {
         let span = node.span;
+        let here = |reason: String| error(src, span, &reason);
         match &node.kind {
-            NodeKind::Number(x) => Ok(Value::constant(*x)),
+            NodeKind::Number(x) => Ok(Value::constant(F::literal(*x).map_err(here)?)),
             NodeKind::Name(name) => self.lower_name(src, span, name),
-            NodeKind::Neg(inner) => Ok(self.lower(src, inner)?.scale(-1.0)),
+            NodeKind::Neg(inner) => self.lower(src, inner)?.negate(src, span),
             NodeKind::Binary(op, lhs, rhs) => {
                 let a = self.lower(src, lhs)?;
                 let b = self.lower(src, rhs)?;
                 match op {
-                    '+' => add(src, span, a, b, 1.0),
-                    '-' => add(src, span, a, b, -1.0),
+                    '+' => add(src, span, a, b),
+                    '-' => add(src, span, a, b.negate(src, span)?),
                     '*' => multiply(src, span, a, b),
                     '/' => {
                         let divisor = b.as_constant().ok_or_else(|| {
                             error(src, rhs.span, "division by a non-constant expression")
                         })?;
-                        if divisor == 0.0 {
+                        if F::constant_value(&divisor) == 0.0 {
                             return Err(error(src, rhs.span, "division by zero"));
                         }
-                        Ok(a.scale(1.0 / divisor))
+                        let inverse = F::reciprocal(&divisor)
+                            .map_err(|reason| error(src, rhs.span, &reason))?;
+                        a.scale(src, span, &inverse)
                     }
                     '^' => {
                         let exponent = b.as_constant().ok_or_else(|| {
                             error(src, rhs.span, "exponent must be a constant integer")
                         })?;
+                        let exponent = F::constant_value(&exponent);
                         if exponent < 0.0 || exponent.fract() != 0.0 || exponent > 64.0 {
                             return Err(error(
                                 src,
@@ -126,40 +171,57 @@ impl ExprContext {
                     _ => unreachable!("parser only builds + - * / ^"),
                 }
             }
-            NodeKind::Call(function, args) => {
-                if function != "cos" && function != "sin" {
-                    return Err(error(
-                        src,
-                        span,
-                        &format!("function `{function}` is not allowed (only cos and sin)"),
-                    ));
+            NodeKind::Call(function, args) => match function.as_str() {
+                "cos" | "sin" => {
+                    if args.len() != 1 {
+                        return Err(error(src, span, "cos and sin take exactly one argument"));
+                    }
+                    let argument = self.lower(src, &args[0])?;
+                    let (terms, constant) = to_angle(src, args[0].span, argument)?;
+                    let (c0, s0) = F::cos_sin(&constant)
+                        .map_err(|reason| error(src, args[0].span, &reason))?;
+                    let (c, s) = LinearAngle { terms, offset: 0.0 }.expand(c0, s0);
+                    Ok(Value::Poly(if function == "cos" { c } else { s }))
                 }
-                if args.len() != 1 {
-                    return Err(error(src, span, "cos and sin take exactly one argument"));
+                "atan2" => {
+                    if args.len() != 2 {
+                        return Err(error(src, span, "atan2 takes exactly two arguments (y, x)"));
+                    }
+                    let constant = |arg: &Node| -> Result<F::Constant, ExprError> {
+                        self.lower(src, arg)?.as_constant().ok_or_else(|| {
+                            error(src, arg.span, "atan2 takes constant arguments only")
+                        })
+                    };
+                    let (y, x) = (constant(&args[0])?, constant(&args[1])?);
+                    if F::constant_value(&y) == 0.0 && F::constant_value(&x) == 0.0 {
+                        return Err(error(src, span, "atan2(0, 0) is undefined"));
+                    }
+                    Ok(Value::constant(F::atan2(&y, &x).map_err(here)?))
                 }
-                let argument = self.lower(src, &args[0])?;
-                let angle = to_angle(src, args[0].span, argument)?;
-                let (c, s) = angle.cos_sin();
-                Ok(Value::Poly(if function == "cos" { c } else { s }))
-            }
+                _ => Err(error(
+                    src,
+                    span,
+                    &format!("function `{function}` is not allowed (only cos, sin and atan2)"),
+                )),
+            },
         }
     }
 
-    fn lower_name(&self, src: &str, span: Span, name: &str) -> Result<Value, ExprError> {
+    fn lower_name(&self, src: &str, span: Span, name: &str) -> Result<Value<F>, ExprError> {
         if let Some(k) = self.coordinates.iter().position(|(n, _)| n == name) {
             return Ok(match self.coordinates[k].1 {
                 VarKind::Angle => Value::Affine(Affine {
                     angles: BTreeMap::from([(k, 1.0)]),
-                    constant: 0.0,
+                    constant: F::zero_constant(),
                 }),
-                VarKind::Length => Value::Poly(TrigPoly::length(k)),
+                VarKind::Length => Value::Poly(Poly::length(k)),
             });
         }
-        if let Some(&value) = self.parameters.get(name) {
-            return Ok(Value::constant(value));
+        if let Some(value) = self.parameters.get(name) {
+            return Ok(Value::constant(value.clone()));
         }
         if name == "pi" {
-            return Ok(Value::constant(std::f64::consts::PI));
+            return Ok(Value::constant(F::pi()));
         }
         Err(error(
             src,
@@ -169,44 +231,61 @@ impl ExprContext {
     }
 }
 
+impl ExprContext {
+    /// Parses an angle: an integer combination of angle coordinates plus a constant.
+    pub fn parse_angle(&self, src: &str) -> Result<LinearAngle, ExprError> {
+        let (terms, offset) = self.parse_angle_parts(src)?;
+        Ok(LinearAngle { terms, offset })
+    }
+}
+
 /// An intermediate value: either a trigonometric polynomial, or an affine combination of bare
 /// angle coordinates (which is only valid inside `cos`/`sin` or as a rotation angle).
 #[derive(Clone, Debug)]
-enum Value {
-    Poly(TrigPoly),
-    Affine(Affine),
+enum Value<F: Field> {
+    Poly(Poly<F>),
+    Affine(Affine<F>),
 }
 
-#[derive(Clone, Debug, Default)]
-struct Affine {
+#[derive(Clone, Debug)]
+struct Affine<F: Field> {
+    /// Multiples of angle coordinates (integers once validated by [`to_angle`]).
     angles: BTreeMap<usize, f64>,
-    constant: f64,
+    constant: F::Constant,
 }
 
-impl Value {
-    fn constant(c: f64) -> Value {
+impl<F: Field> Value<F> {
+    fn constant(c: F::Constant) -> Self {
         Value::Affine(Affine {
             angles: BTreeMap::new(),
             constant: c,
         })
     }
 
-    fn as_constant(&self) -> Option<f64> {
+    fn as_constant(&self) -> Option<F::Constant> {
         match self {
-            Value::Affine(a) if a.angles.is_empty() => Some(a.constant),
-            Value::Poly(p) if p.is_constant() => Some(p.constant_term()),
+            Value::Affine(a) if a.angles.is_empty() => Some(a.constant.clone()),
+            Value::Poly(p) if p.is_constant() => Some(F::from_scalar(p.constant_term())),
             _ => None,
         }
     }
 
-    fn scale(self, s: f64) -> Value {
-        match self {
-            Value::Poly(p) => Value::Poly(p.scale(s)),
-            Value::Affine(a) => Value::Affine(Affine {
-                angles: a.angles.into_iter().map(|(k, n)| (k, n * s)).collect(),
-                constant: a.constant * s,
-            }),
-        }
+    fn negate(self, src: &str, span: Span) -> Result<Self, ExprError> {
+        self.scale(src, span, &F::literal(-1.0).expect("-1 is a number"))
+    }
+
+    fn scale(self, src: &str, span: Span, s: &F::Constant) -> Result<Self, ExprError> {
+        let here = |reason: String| error(src, span, &reason);
+        Ok(match self {
+            Value::Poly(p) => Value::Poly(p.scale(F::to_scalar(s).map_err(here)?)),
+            Value::Affine(a) => {
+                let factor = F::constant_value(s);
+                Value::Affine(Affine {
+                    angles: a.angles.into_iter().map(|(k, n)| (k, n * factor)).collect(),
+                    constant: F::mul_constants(&a.constant, s).map_err(here)?,
+                })
+            }
+        })
     }
 }
 
@@ -218,32 +297,38 @@ fn bare_angle_error(src: &str, span: Span) -> ExprError {
     )
 }
 
-fn add(src: &str, span: Span, a: Value, b: Value, sign: f64) -> Result<Value, ExprError> {
-    match (a, b.scale(sign)) {
+fn add<F: Field>(src: &str, span: Span, a: Value<F>, b: Value<F>) -> Result<Value<F>, ExprError> {
+    match (a, b) {
         (Value::Affine(mut x), Value::Affine(y)) => {
             for (k, n) in y.angles {
                 *x.angles.entry(k).or_insert(0.0) += n;
             }
             x.angles.retain(|_, n| *n != 0.0);
-            x.constant += y.constant;
+            x.constant = F::add_constants(&x.constant, &y.constant);
             Ok(Value::Affine(x))
         }
         (Value::Poly(p), Value::Affine(a)) | (Value::Affine(a), Value::Poly(p)) => {
             if !a.angles.is_empty() {
                 return Err(bare_angle_error(src, span));
             }
-            Ok(Value::Poly(&p + &TrigPoly::constant(a.constant)))
+            let c = F::to_scalar(&a.constant).map_err(|reason| error(src, span, &reason))?;
+            Ok(Value::Poly(&p + &Poly::constant(c)))
         }
         (Value::Poly(p), Value::Poly(q)) => Ok(Value::Poly(&p + &q)),
     }
 }
 
-fn multiply(src: &str, span: Span, a: Value, b: Value) -> Result<Value, ExprError> {
+fn multiply<F: Field>(
+    src: &str,
+    span: Span,
+    a: Value<F>,
+    b: Value<F>,
+) -> Result<Value<F>, ExprError> {
     if let Some(c) = a.as_constant() {
-        return Ok(b.scale(c));
+        return b.scale(src, span, &c);
     }
     if let Some(c) = b.as_constant() {
-        return Ok(a.scale(c));
+        return a.scale(src, span, &c);
     }
     match (a, b) {
         (Value::Poly(p), Value::Poly(q)) => {
@@ -259,9 +344,10 @@ fn multiply(src: &str, span: Span, a: Value, b: Value) -> Result<Value, ExprErro
     }
 }
 
-fn power(src: &str, span: Span, a: Value, n: u32) -> Result<Value, ExprError> {
+fn power<F: Field>(src: &str, span: Span, a: Value<F>, n: u32) -> Result<Value<F>, ExprError> {
     if let Some(c) = a.as_constant() {
-        return Ok(Value::constant(c.powi(n as i32)));
+        let value = F::pow_constant(&c, n).map_err(|reason| error(src, span, &reason))?;
+        return Ok(Value::constant(value));
     }
     match a {
         Value::Poly(p) => {
@@ -291,12 +377,16 @@ fn check_degree(src: &str, span: Span, degree: u32) -> Result<(), ExprError> {
     Ok(())
 }
 
-fn to_angle(src: &str, span: Span, value: Value) -> Result<LinearAngle, ExprError> {
+fn to_angle<F: Field>(
+    src: &str,
+    span: Span,
+    value: Value<F>,
+) -> Result<(Vec<(usize, i32)>, F::Constant), ExprError> {
     let affine = match value {
         Value::Affine(a) => a,
         Value::Poly(p) if p.is_constant() => Affine {
             angles: BTreeMap::new(),
-            constant: p.constant_term(),
+            constant: F::from_scalar(p.constant_term()),
         },
         Value::Poly(_) => {
             return Err(error(
@@ -320,10 +410,7 @@ fn to_angle(src: &str, span: Span, value: Value) -> Result<LinearAngle, ExprErro
             terms.push((k, rounded as i32));
         }
     }
-    Ok(LinearAngle {
-        terms,
-        offset: affine.constant,
-    })
+    Ok((terms, affine.constant))
 }
 
 // ---------------------------------------------------------------- tokens and parser
@@ -632,7 +719,7 @@ mod tests {
     #[test]
     fn refuses_what_is_not_a_trig_polynomial() {
         refused("sqrt(2)", "sqrt(2)");
-        refused("1 + atan2(th1, th2)", "atan2(th1, th2)");
+        refused("1 + atan2(th1, th2)", "th1");
         refused("cos(th1*th2)", "th1*th2");
         refused("1/th2", "th2");
         refused("d1/rho", "rho");

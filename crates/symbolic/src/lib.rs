@@ -6,16 +6,23 @@
 //! coefficient extraction into reading a map. This crate is that algebra: [`TrigPoly`] (canonical
 //! sparse polynomials with `sin² = 1 − cos²` reduced), [`LinearAngle`] rotations,
 //! [`PolyVec3`]/[`PolyMat3`] poses, and the case-file expression language in [`expr`].
+//!
+//! The algebra is generic over the coefficient [`Scalar`]: `f64` ([`TrigPoly`]) for kinematics
+//! and dynamics, exact rationals ([`ExactPoly`]) for the balance decision, built by the same code.
 
 pub mod angle;
 pub mod display;
 pub mod expr;
+pub mod field;
 pub mod geometry;
 pub mod monomial;
 pub mod poly;
+pub mod scalar;
 
 pub use angle::LinearAngle;
-pub use expr::{ExprContext, ExprError};
-pub use geometry::{PolyMat3, PolyVec3};
+pub use expr::{Context, ExactContext, ExprContext, ExprError};
+pub use field::{ExactConstant, Field};
+pub use geometry::{ExactMat3, ExactVec3, Mat3, PolyMat3, PolyVec3, Vec3};
 pub use monomial::{MAX_VARS, Monomial, VarKind};
-pub use poly::{Point, TrigPoly};
+pub use poly::{ExactPoly, Point, Poly, TrigPoly};
+pub use scalar::{Rational, Scalar, decimal_to_rational, rational_to_f64};

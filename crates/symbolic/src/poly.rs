@@ -1,9 +1,12 @@
-//! Canonical trigonometric polynomials: sparse maps from [`Monomial`] to `f64` coefficients.
+//! Canonical trigonometric polynomials: sparse maps from [`Monomial`] to coefficients of a
+//! [`Scalar`] field — `f64` ([`TrigPoly`]) for the numeric stages, exact rationals
+//! ([`ExactPoly`]) for the balance decision.
 
 use std::collections::BTreeMap;
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
 use crate::monomial::{MAX_VARS, Monomial, VarKind};
+use crate::scalar::{Rational, Scalar};
 
 /// A point of the chart at which polynomials are evaluated: `cos`/`sin` of the angles and the
 /// values of the lengths, computed once and shared by every polynomial evaluated there.
@@ -51,45 +54,53 @@ impl Point {
     }
 }
 
-/// A trigonometric polynomial in the chart coordinates, in canonical form.
+/// A trigonometric polynomial in the chart coordinates, in canonical form, with coefficients in
+/// the field `C`.
 ///
 /// Zero coefficients are never stored, so two polynomials are equal as functions exactly when
-/// their maps are equal (up to floating-point rounding of the coefficients, see
-/// [`TrigPoly::prune`] and [`TrigPoly::approx_eq`]).
+/// their maps are equal (for `f64`, up to rounding of the coefficients, see [`TrigPoly::prune`]
+/// and [`TrigPoly::approx_eq`]; for rationals, exactly).
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct TrigPoly {
-    terms: BTreeMap<Monomial, f64>,
+pub struct Poly<C> {
+    terms: BTreeMap<Monomial, C>,
 }
 
-impl TrigPoly {
-    pub fn zero() -> TrigPoly {
-        TrigPoly::default()
+/// The numeric polynomial used by kinematics, dynamics and optimisation.
+pub type TrigPoly = Poly<f64>;
+/// The exact polynomial used by the balance decision.
+pub type ExactPoly = Poly<Rational>;
+
+impl<C: Scalar> Poly<C> {
+    pub fn zero() -> Self {
+        Poly {
+            terms: BTreeMap::new(),
+        }
     }
 
-    pub fn constant(c: f64) -> TrigPoly {
-        TrigPoly::monomial(Monomial::ONE, c)
+    pub fn constant(c: C) -> Self {
+        Self::monomial(Monomial::ONE, c)
     }
 
     /// `coefficient · m`.
-    pub fn monomial(m: Monomial, coefficient: f64) -> TrigPoly {
-        let mut p = TrigPoly::zero();
+    pub fn monomial(m: Monomial, coefficient: C) -> Self {
+        let mut p = Self::zero();
         p.add_term(m, coefficient);
         p
     }
 
     /// `cos q_var` of an angle coordinate.
-    pub fn cos(var: usize) -> TrigPoly {
-        TrigPoly::monomial(Monomial::base(var), 1.0)
+    pub fn cos(var: usize) -> Self {
+        Self::monomial(Monomial::base(var), C::one())
     }
 
     /// `sin q_var` of an angle coordinate.
-    pub fn sin(var: usize) -> TrigPoly {
-        TrigPoly::monomial(Monomial::sine(var), 1.0)
+    pub fn sin(var: usize) -> Self {
+        Self::monomial(Monomial::sine(var), C::one())
     }
 
     /// The length coordinate `q_var` itself.
-    pub fn length(var: usize) -> TrigPoly {
-        TrigPoly::monomial(Monomial::base(var), 1.0)
+    pub fn length(var: usize) -> Self {
+        Self::monomial(Monomial::base(var), C::one())
     }
 
     pub fn is_zero(&self) -> bool {
@@ -100,18 +111,23 @@ impl TrigPoly {
         self.terms.keys().all(Monomial::is_one)
     }
 
-    pub fn constant_term(&self) -> f64 {
+    pub fn constant_term(&self) -> C {
         self.coefficient(&Monomial::ONE)
     }
 
     /// Coefficient of a basis monomial (zero when absent).
-    pub fn coefficient(&self, m: &Monomial) -> f64 {
-        self.terms.get(m).copied().unwrap_or(0.0)
+    pub fn coefficient(&self, m: &Monomial) -> C {
+        self.terms.get(m).cloned().unwrap_or_else(C::zero)
     }
 
-    /// Terms in canonical (deterministic) order.
-    pub fn terms(&self) -> impl Iterator<Item = (&Monomial, f64)> + '_ {
-        self.terms.iter().map(|(m, &c)| (m, c))
+    /// Terms in canonical (deterministic) order, coefficients by value.
+    pub fn terms(&self) -> impl Iterator<Item = (&Monomial, C)> + '_ {
+        self.terms.iter().map(|(m, c)| (m, c.clone()))
+    }
+
+    /// Terms in canonical order, coefficients by reference.
+    pub fn terms_ref(&self) -> impl Iterator<Item = (&Monomial, &C)> + '_ {
+        self.terms.iter()
     }
 
     pub fn len(&self) -> usize {
@@ -122,54 +138,42 @@ impl TrigPoly {
         self.terms.is_empty()
     }
 
-    /// Largest coefficient magnitude (zero for the zero polynomial).
-    pub fn max_abs_coefficient(&self) -> f64 {
-        self.terms.values().fold(0.0, |acc, c| acc.max(c.abs()))
-    }
-
     /// Adds `coefficient · m`, dropping the term if it cancels exactly.
-    pub fn add_term(&mut self, m: Monomial, coefficient: f64) {
-        if coefficient == 0.0 {
+    pub fn add_term(&mut self, m: Monomial, coefficient: C) {
+        if coefficient.is_zero() {
             return;
         }
-        let entry = self.terms.entry(m).or_insert(0.0);
-        *entry += coefficient;
-        if *entry == 0.0 {
-            self.terms.remove(&m);
+        match self.terms.entry(m) {
+            std::collections::btree_map::Entry::Vacant(slot) => {
+                slot.insert(coefficient);
+            }
+            std::collections::btree_map::Entry::Occupied(mut slot) => {
+                let sum = slot.get().add_ref(&coefficient);
+                if sum.is_zero() {
+                    slot.remove();
+                } else {
+                    *slot.get_mut() = sum;
+                }
+            }
         }
     }
 
-    /// Drops coefficients of magnitude at most `tol`: the residue of cancellations such as
-    /// `cos²θ + sin²θ − 1` computed in floating point. Absolute, because a polynomial that should
-    /// be zero has nothing to be relative to; see [`TrigPoly::prune_relative`].
-    pub fn prune(&mut self, tol: f64) {
-        self.terms.retain(|_, c| c.abs() > tol);
-    }
-
-    /// Drops coefficients of magnitude at most `tol` times the largest one.
-    pub fn prune_relative(&mut self, tol: f64) {
-        let limit = tol * self.max_abs_coefficient();
-        self.terms.retain(|_, c| c.abs() > limit);
-    }
-
-    /// Equality of coefficient maps within `tol` times the larger maximum coefficient.
-    pub fn approx_eq(&self, other: &TrigPoly, tol: f64) -> bool {
-        let scale = self.max_abs_coefficient().max(other.max_abs_coefficient());
-        (self - other).max_abs_coefficient() <= tol * scale
-    }
-
-    pub fn scale(&self, s: f64) -> TrigPoly {
-        if s == 0.0 {
-            return TrigPoly::zero();
+    pub fn scale(&self, s: C) -> Self {
+        if s.is_zero() {
+            return Self::zero();
         }
-        TrigPoly {
-            terms: self.terms.iter().map(|(m, c)| (*m, c * s)).collect(),
+        Poly {
+            terms: self
+                .terms
+                .iter()
+                .map(|(m, c)| (*m, c.mul_ref(&s)))
+                .collect(),
         }
     }
 
     /// `self^n` by repeated squaring.
-    pub fn pow(&self, n: u32) -> TrigPoly {
-        let mut result = TrigPoly::constant(1.0);
+    pub fn pow(&self, n: u32) -> Self {
+        let mut result = Self::constant(C::one());
         let mut base = self.clone();
         let mut n = n;
         while n > 0 {
@@ -188,14 +192,15 @@ impl TrigPoly {
     ///
     /// Angle: `d(cᵃ sᵇ)/dθ = −a cᵃ⁻¹ sᵇ⁺¹ + b cᵃ⁺¹ sᵇ⁻¹`, with `s² = 1 − c²` reduced.
     /// Length: `d(xᵉ)/dx = e xᵉ⁻¹`.
-    pub fn derivative(&self, var: usize, kind: VarKind) -> TrigPoly {
-        let mut out = TrigPoly::zero();
-        for (m, &c) in &self.terms {
+    pub fn derivative(&self, var: usize, kind: VarKind) -> Self {
+        let mut out = Self::zero();
+        for (m, c) in &self.terms {
             let a = m.power(var);
+            let ca = c.mul_ref(&C::from_i64(i64::from(a)));
             match kind {
                 VarKind::Length => {
                     if a > 0 {
-                        out.add_term(m.with_power(var, a - 1), c * f64::from(a));
+                        out.add_term(m.with_power(var, a - 1), ca);
                     }
                 }
                 VarKind::Angle => {
@@ -206,15 +211,15 @@ impl TrigPoly {
                         if b {
                             // s² = 1 − c²: −a cᵃ⁻¹ (1 − c²) = −a cᵃ⁻¹ + a cᵃ⁺¹
                             let without_sine = lowered.with_sine(var, false);
-                            out.add_term(without_sine, -c * f64::from(a));
-                            out.add_term(without_sine.with_power(var, a + 1), c * f64::from(a));
+                            out.add_term(without_sine, ca.neg_ref());
+                            out.add_term(without_sine.with_power(var, a + 1), ca);
                         } else {
-                            out.add_term(lowered.with_sine(var, true), -c * f64::from(a));
+                            out.add_term(lowered.with_sine(var, true), ca.neg_ref());
                         }
                     }
                     if b {
                         // b cᵃ⁺¹ sᵇ⁻¹
-                        out.add_term(m.with_sine(var, false).with_power(var, a + 1), c);
+                        out.add_term(m.with_sine(var, false).with_power(var, a + 1), c.clone());
                     }
                 }
             }
@@ -222,8 +227,21 @@ impl TrigPoly {
         out
     }
 
+    /// Value at a chart point (coefficients rounded to `f64` first for exact polynomials).
     pub fn eval(&self, at: &Point) -> f64 {
-        self.terms.iter().map(|(m, c)| c * at.monomial(m)).sum()
+        self.terms
+            .iter()
+            .map(|(m, c)| c.to_f64() * at.monomial(m))
+            .sum()
+    }
+
+    /// The same polynomial with every coefficient rounded to the nearest double.
+    pub fn to_f64(&self) -> TrigPoly {
+        let mut out = TrigPoly::zero();
+        for (m, c) in &self.terms {
+            out.add_term(*m, c.to_f64());
+        }
+        out
     }
 
     /// Highest power of any single coordinate (`cos q_k` or `q_k`) in any term.
@@ -248,28 +266,55 @@ impl TrigPoly {
         (0..MAX_VARS).filter(|&k| used[k]).collect()
     }
 
-    fn mul_ref(&self, other: &TrigPoly) -> TrigPoly {
-        let mut out = TrigPoly::zero();
-        for (ma, &ca) in &self.terms {
-            for (mb, &cb) in &other.terms {
+    fn mul_ref(&self, other: &Self) -> Self {
+        let mut out = Self::zero();
+        for (ma, ca) in &self.terms {
+            for (mb, cb) in &other.terms {
                 let (m, squared) = ma.raw_product(mb);
-                out.add_reduced(m, squared, ca * cb);
+                out.add_reduced(m, squared, ca.mul_ref(cb));
             }
         }
         out
     }
 
     /// Adds `coefficient · m · Π_{k ∈ squared} s_k²`, expanding each `s_k² = 1 − c_k²`.
-    fn add_reduced(&mut self, m: Monomial, squared: u16, coefficient: f64) {
+    fn add_reduced(&mut self, m: Monomial, squared: u16, coefficient: C) {
         if squared == 0 {
             self.add_term(m, coefficient);
             return;
         }
         let k = squared.trailing_zeros() as usize;
         let rest = squared & !(1 << k);
-        self.add_reduced(m, rest, coefficient);
         let raised = m.power(k) + 2;
-        self.add_reduced(m.with_power(k, raised), rest, -coefficient);
+        let negated = coefficient.neg_ref();
+        self.add_reduced(m, rest, coefficient);
+        self.add_reduced(m.with_power(k, raised), rest, negated);
+    }
+}
+
+impl TrigPoly {
+    /// Largest coefficient magnitude (zero for the zero polynomial).
+    pub fn max_abs_coefficient(&self) -> f64 {
+        self.terms.values().fold(0.0, |acc, c| acc.max(c.abs()))
+    }
+
+    /// Drops coefficients of magnitude at most `tol`: the residue of cancellations such as
+    /// `cos²θ + sin²θ − 1` computed in floating point. Absolute, because a polynomial that should
+    /// be zero has nothing to be relative to; see [`TrigPoly::prune_relative`].
+    pub fn prune(&mut self, tol: f64) {
+        self.terms.retain(|_, c| c.abs() > tol);
+    }
+
+    /// Drops coefficients of magnitude at most `tol` times the largest one.
+    pub fn prune_relative(&mut self, tol: f64) {
+        let limit = tol * self.max_abs_coefficient();
+        self.terms.retain(|_, c| c.abs() > limit);
+    }
+
+    /// Equality of coefficient maps within `tol` times the larger maximum coefficient.
+    pub fn approx_eq(&self, other: &TrigPoly, tol: f64) -> bool {
+        let scale = self.max_abs_coefficient().max(other.max_abs_coefficient());
+        (self - other).max_abs_coefficient() <= tol * scale
     }
 }
 
@@ -279,60 +324,62 @@ impl From<f64> for TrigPoly {
     }
 }
 
-impl AddAssign<&TrigPoly> for TrigPoly {
-    fn add_assign(&mut self, rhs: &TrigPoly) {
-        for (m, &c) in &rhs.terms {
-            self.add_term(*m, c);
+impl<C: Scalar> AddAssign<&Poly<C>> for Poly<C> {
+    fn add_assign(&mut self, rhs: &Poly<C>) {
+        for (m, c) in &rhs.terms {
+            self.add_term(*m, c.clone());
         }
     }
 }
 
-impl SubAssign<&TrigPoly> for TrigPoly {
-    fn sub_assign(&mut self, rhs: &TrigPoly) {
-        for (m, &c) in &rhs.terms {
-            self.add_term(*m, -c);
+impl<C: Scalar> SubAssign<&Poly<C>> for Poly<C> {
+    fn sub_assign(&mut self, rhs: &Poly<C>) {
+        for (m, c) in &rhs.terms {
+            self.add_term(*m, c.neg_ref());
         }
     }
 }
 
-impl Neg for &TrigPoly {
-    type Output = TrigPoly;
-    fn neg(self) -> TrigPoly {
-        self.scale(-1.0)
+impl<C: Scalar> Neg for &Poly<C> {
+    type Output = Poly<C>;
+    fn neg(self) -> Poly<C> {
+        Poly {
+            terms: self.terms.iter().map(|(m, c)| (*m, c.neg_ref())).collect(),
+        }
     }
 }
 
-impl Neg for TrigPoly {
-    type Output = TrigPoly;
-    fn neg(self) -> TrigPoly {
-        self.scale(-1.0)
+impl<C: Scalar> Neg for Poly<C> {
+    type Output = Poly<C>;
+    fn neg(self) -> Poly<C> {
+        -&self
     }
 }
 
 macro_rules! binary_ops {
     ($trait:ident, $method:ident, $body:expr) => {
-        impl $trait<&TrigPoly> for &TrigPoly {
-            type Output = TrigPoly;
-            fn $method(self, rhs: &TrigPoly) -> TrigPoly {
-                let f: fn(&TrigPoly, &TrigPoly) -> TrigPoly = $body;
+        impl<C: Scalar> $trait<&Poly<C>> for &Poly<C> {
+            type Output = Poly<C>;
+            fn $method(self, rhs: &Poly<C>) -> Poly<C> {
+                let f: fn(&Poly<C>, &Poly<C>) -> Poly<C> = $body;
                 f(self, rhs)
             }
         }
-        impl $trait<TrigPoly> for TrigPoly {
-            type Output = TrigPoly;
-            fn $method(self, rhs: TrigPoly) -> TrigPoly {
+        impl<C: Scalar> $trait<Poly<C>> for Poly<C> {
+            type Output = Poly<C>;
+            fn $method(self, rhs: Poly<C>) -> Poly<C> {
                 (&self).$method(&rhs)
             }
         }
-        impl $trait<&TrigPoly> for TrigPoly {
-            type Output = TrigPoly;
-            fn $method(self, rhs: &TrigPoly) -> TrigPoly {
+        impl<C: Scalar> $trait<&Poly<C>> for Poly<C> {
+            type Output = Poly<C>;
+            fn $method(self, rhs: &Poly<C>) -> Poly<C> {
                 (&self).$method(rhs)
             }
         }
-        impl $trait<TrigPoly> for &TrigPoly {
-            type Output = TrigPoly;
-            fn $method(self, rhs: TrigPoly) -> TrigPoly {
+        impl<C: Scalar> $trait<Poly<C>> for &Poly<C> {
+            type Output = Poly<C>;
+            fn $method(self, rhs: Poly<C>) -> Poly<C> {
                 self.$method(&rhs)
             }
         }

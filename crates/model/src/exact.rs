@@ -1,0 +1,246 @@
+//! The mechanism in exact rational arithmetic, for the balance decision.
+//!
+//! Every number of a case file is read as the decimal the designer wrote (the shortest decimal
+//! that rounds to the double serde produced; see [`counterpoise_symbolic::decimal_to_rational`]).
+//! Rotations stay exact when their constant part is a multiple of π/2 or a rational rotation
+//! `atan2(y, x)` with a rational hypotenuse. The poses are lowered by the same generic code as
+//! the numeric model ([`crate::pose::Parser`]), so the two cannot disagree on a formula; where a
+//! constant is irrational (`rot_z: 0.3`, `d1*pi`), [`exact_mechanism`] says why and the caller
+//! decides numerically.
+
+use std::collections::BTreeMap;
+
+use counterpoise_symbolic::{
+    ExactContext, ExactMat3, ExactPoly, ExactVec3, Field, Poly, Rational, VarKind,
+};
+
+use crate::case::Expr;
+use crate::model::{BodyId, Model};
+use crate::pose::{Parser, SymbolicPose};
+
+/// One body's exact world pose: `x_world = origin + rotation · x_body`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExactFrame {
+    pub rotation: ExactMat3,
+    pub origin: ExactVec3,
+}
+
+/// What the exact balance decision needs: gravity, every body's pose and the unbalanced energy,
+/// all with rational coefficients.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExactMechanism {
+    pub gravity: [Rational; 3],
+    /// In the model's body order.
+    pub bodies: Vec<ExactFrame>,
+    /// Gravitational potential of the bodies and the payloads marked `in_balance` (J).
+    pub unbalanced: ExactPoly,
+}
+
+/// Why a case cannot be taken exactly: the field and the reason.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{path}: {reason}")]
+pub struct NotExact {
+    pub path: String,
+    pub reason: String,
+}
+
+fn not_exact(path: impl Into<String>, reason: impl Into<String>) -> NotExact {
+    NotExact {
+        path: path.into(),
+        reason: reason.into(),
+    }
+}
+
+fn literal(x: f64, path: &str) -> Result<Rational, NotExact> {
+    let constant = Rational::literal(x).map_err(|r| not_exact(path, r))?;
+    Rational::to_scalar(&constant).map_err(|r| not_exact(path, r))
+}
+
+/// Builds the exact mechanism of a validated model, or says which field prevents it.
+pub fn exact_mechanism(model: &Model) -> Result<ExactMechanism, NotExact> {
+    let case = &model.case;
+    let mut parameters = BTreeMap::new();
+    for (name, value) in case.parameters.iter() {
+        let constant =
+            Rational::literal(*value).map_err(|r| not_exact(format!("parameters.{name}"), r))?;
+        parameters.insert(name.to_string(), constant);
+    }
+    let coordinates: Vec<(String, VarKind)> = model
+        .coordinates
+        .iter()
+        .map(|c| (c.name.clone(), c.kind))
+        .collect();
+    let context = ExactContext::new(parameters, coordinates);
+    let parser = Parser { context: &context };
+
+    let first_error = |errors: Vec<crate::ModelError>, path: String| -> NotExact {
+        errors.into_iter().next().map_or_else(
+            || not_exact(path, "not exact"),
+            |e| not_exact(e.path().to_string(), e.to_string()),
+        )
+    };
+    let mut relative = Vec::with_capacity(case.bodies.len());
+    for (i, body) in case.bodies.iter().enumerate() {
+        let path = format!("bodies[{i}].pose");
+        let mut errors = Vec::new();
+        let pose = parser.pose(&body.pose, &path, &mut errors);
+        relative.push(pose.ok_or_else(|| first_error(errors, path))?);
+    }
+    let mut world: Vec<Option<SymbolicPose<Rational>>> = vec![None; case.bodies.len()];
+    for i in 0..model.bodies.len() {
+        world_pose(model, &relative, &mut world, i);
+    }
+    let bodies: Vec<ExactFrame> = world
+        .into_iter()
+        .map(|p| {
+            let p = p.expect("every body's world pose was composed");
+            ExactFrame {
+                rotation: p.rotation,
+                origin: p.origin,
+            }
+        })
+        .collect();
+
+    let gravity = [
+        literal(case.gravity[0], "gravity[0]")?,
+        literal(case.gravity[1], "gravity[1]")?,
+        literal(case.gravity[2], "gravity[2]")?,
+    ];
+    let point = |exprs: &[Expr; 3], path: &str| -> Result<[Rational; 3], NotExact> {
+        let mut errors = Vec::new();
+        let constants = parser
+            .constant_vec(exprs, path, &mut errors)
+            .ok_or_else(|| first_error(errors, path.to_string()))?;
+        let mut out: [Rational; 3] = Default::default();
+        for (k, c) in constants.iter().enumerate() {
+            out[k] = Rational::to_scalar(c).map_err(|r| not_exact(format!("{path}[{k}]"), r))?;
+        }
+        Ok(out)
+    };
+    let mut unbalanced = ExactPoly::zero();
+    for (i, body) in case.bodies.iter().enumerate() {
+        if body.mass == 0.0 {
+            continue;
+        }
+        let path = format!("bodies[{i}]");
+        let mass = literal(body.mass, &format!("{path}.mass"))?;
+        let com = match &body.com {
+            Some(com) => point(com, &format!("{path}.com"))?,
+            None => Default::default(),
+        };
+        unbalanced += &gravity_potential(&bodies[i], &gravity, &mass, com);
+    }
+    for (j, payload) in case.payloads.iter().enumerate() {
+        if !payload.in_balance || payload.mass == 0.0 {
+            continue;
+        }
+        let path = format!("payloads[{j}]");
+        let body = model.payloads[j].body;
+        let mass = literal(payload.mass, &format!("{path}.mass"))?;
+        let com = point(&payload.com, &format!("{path}.com"))?;
+        unbalanced += &gravity_potential(&bodies[body], &gravity, &mass, com);
+    }
+    Ok(ExactMechanism {
+        gravity,
+        bodies,
+        unbalanced,
+    })
+}
+
+/// `−m g·(p + R c)`: the potential of mass `m` at `c` in the frame's body axes.
+fn gravity_potential(
+    frame: &ExactFrame,
+    gravity: &[Rational; 3],
+    mass: &Rational,
+    com: [Rational; 3],
+) -> ExactPoly {
+    let world = frame.origin.add(&frame.rotation.mul_const_vec(com));
+    world.dot_const(gravity.clone()).scale(-mass.clone())
+}
+
+/// Composes body `i`'s world pose from its parent's (memoised; the parent relation is acyclic
+/// in a validated model).
+fn world_pose(
+    model: &Model,
+    relative: &[SymbolicPose<Rational>],
+    world: &mut Vec<Option<SymbolicPose<Rational>>>,
+    i: usize,
+) -> SymbolicPose<Rational> {
+    if let Some(pose) = &world[i] {
+        return pose.clone();
+    }
+    let pose = match model.bodies[i].parent {
+        BodyId::Base => relative[i].clone(),
+        BodyId::Body(p) => world_pose(model, relative, world, p).compose(&relative[i]),
+    };
+    world[i] = Some(pose.clone());
+    pose
+}
+
+impl ExactMechanism {
+    /// The exact energy with coefficients rounded to doubles (for comparison with the model).
+    pub fn unbalanced_f64(&self) -> counterpoise_symbolic::TrigPoly {
+        Poly::to_f64(&self.unbalanced)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use counterpoise_symbolic::Monomial;
+    use num_bigint::BigInt;
+
+    fn q(n: i64, d: i64) -> Rational {
+        Rational::new(BigInt::from(n), BigInt::from(d))
+    }
+
+    const PENDULUM: &str = r#"{
+        "name": "p", "gravity": [0, -9.81, 0],
+        "parameters": { "l": 0.3 },
+        "coordinates": [ { "name": "th", "kind": "angle", "range": [-3, 3] } ],
+        "bodies": [ { "name": "rod", "parent": "base", "pose": [ { "rot_z": "th - pi/2" } ],
+                      "mass": 2, "com": ["4*l/3", 0, 0], "inertia": [0, 0, 0.1, 0, 0, 0] } ],
+        "joints": [ { "name": "J1", "kind": "revolute", "bodies": ["base", "rod"],
+                      "point": [0, 0, 0], "axis": [0, 0, 1] } ],
+        "actuators": [ { "name": "M1", "joint": "J1", "coordinate": "th", "ratio": 1 } ]
+    }"#;
+
+    #[test]
+    fn pendulum_energy_is_the_hand_calculation() {
+        // CoM at R(th − π/2)·(0.4, 0): y_c = −0.4 cos th, and with gravity (0, −9.81, 0)
+        // V = m·9.81·y_c = 2 · 9.81 · (−0.4) cos th = −7.848 cos th = −981/125 cos th.
+        let model = crate::Case::from_json_str(PENDULUM).unwrap();
+        let exact = exact_mechanism(&model).unwrap();
+        let mut expected = ExactPoly::zero();
+        expected.add_term(Monomial::base(0), q(-981, 125));
+        assert_eq!(exact.unbalanced, expected);
+        // The numeric model agrees to rounding.
+        let numeric = model.potential_energy(crate::PayloadMode::InBalance);
+        assert!(numeric.approx_eq(&exact.unbalanced_f64(), 1e-15));
+    }
+
+    #[test]
+    fn irrational_rotation_names_the_field() {
+        let text = PENDULUM.replace("th - pi/2", "th - 0.3");
+        let model = crate::Case::from_json_str(&text).unwrap();
+        let err = exact_mechanism(&model).unwrap_err();
+        assert_eq!(err.path, "bodies[0].pose[0].rot_z");
+        assert!(err.reason.contains("irrational"), "{err}");
+    }
+
+    #[test]
+    fn rational_rotation_by_atan2_is_exact() {
+        // rot_z(th + atan2(4, 3)), CoM 5 along x: y = 5 sin(th + φ) with cos φ = 3/5,
+        // sin φ = 4/5, so y = 5 (sin th · 3/5 + cos th · 4/5) = 3 sin th + 4 cos th.
+        let text = PENDULUM
+            .replace("th - pi/2", "th + atan2(4, 3)")
+            .replace("\"4*l/3\", 0, 0", "5, 0, 0");
+        let model = crate::Case::from_json_str(&text).unwrap();
+        let exact = exact_mechanism(&model).unwrap();
+        // V = m g y = 2 · 9.81 · (3 sin th + 4 cos th).
+        let mut expected = ExactPoly::zero();
+        expected.add_term(Monomial::sine(0), q(2 * 981 * 3, 100));
+        expected.add_term(Monomial::base(0), q(2 * 981 * 4, 100));
+        assert_eq!(exact.unbalanced, expected);
+    }
+}
