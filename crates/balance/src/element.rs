@@ -12,7 +12,7 @@
 //! these polynomials, whatever the variant.
 
 pub use counterpoise_model::Plane;
-use counterpoise_symbolic::{PolyMat3, PolyVec3, TrigPoly};
+use counterpoise_symbolic::{Mat3, Poly, Scalar, TrigPoly, Vec3};
 use serde::Serialize;
 
 use crate::energy::MechanismEnergy;
@@ -116,20 +116,60 @@ impl Catalogue {
     }
 }
 
-fn gravity_dot(gravity: [f64; 3], v: &PolyVec3) -> TrigPoly {
-    v.dot_const(gravity)
+/// Energy per unit of each lifted variable of a counterweight on a body with world pose
+/// `(rotation, origin)`: `V = −m g·p − g·R μ`, so `[−g·p, −g·R e_k for k in axes]`.
+///
+/// Generic over the field so that the exact decision and the numeric stages use one formula.
+pub fn counterweight_energy<C: Scalar>(
+    gravity: &[C; 3],
+    rotation: &Mat3<C>,
+    origin: &Vec3<C>,
+    axes: &[usize],
+) -> Vec<Poly<C>> {
+    let minus_g = gravity.clone().map(|g| g.neg_ref());
+    let mut polys = vec![origin.dot_const(minus_g.clone())];
+    for &axis in axes {
+        polys.push(rotation.column(axis).dot_const(minus_g.clone()));
+    }
+    polys
+}
+
+/// Energy per unit of each lifted variable of a zero-free-length spring from body `i` (pose
+/// `frame`) to `other` (the base when `None`): with `d = p_i − p_s`,
+/// `[½|d|², R_i e_k·d, −R_s e_l·d, −R_i e_k·R_s e_l]` for `K`, `K a_k`, `K b_l`, `K a_k b_l`.
+pub fn spring_energy<C: Scalar>(
+    frame: (&Mat3<C>, &Vec3<C>),
+    other: Option<(&Mat3<C>, &Vec3<C>)>,
+    axes: &[usize],
+) -> Vec<Poly<C>> {
+    let (rotation, origin) = frame;
+    let identity = Mat3::identity();
+    let zero = Vec3::zero();
+    let (other_rotation, other_origin) = other.unwrap_or((&identity, &zero));
+    let d = origin.sub(other_origin);
+    let mut polys = vec![d.dot(&d).scale(C::from_ratio(1, 2))];
+    for &k in axes {
+        polys.push(rotation.column(k).dot(&d));
+    }
+    for &l in axes {
+        polys.push(-other_rotation.column(l).dot(&d));
+    }
+    for &k in axes {
+        for &l in axes {
+            polys.push(-rotation.column(k).dot(&other_rotation.column(l)));
+        }
+    }
+    polys
 }
 
 fn counterweight(energy: &MechanismEnergy, body: usize, axes: &[usize]) -> CatalogueEntry {
     let frame = &energy.bodies[body];
     let n = body + 1;
     let mut variables = vec![format!("m{n}")];
-    // V = −m g·p − g·R μ
-    let mut polys = vec![-gravity_dot(energy.gravity, &frame.origin)];
     for &axis in axes {
         variables.push(format!("m{n}·r{n}{}", AXIS[axis]));
-        polys.push(-gravity_dot(energy.gravity, &frame.rotation.column(axis)));
     }
+    let polys = counterweight_energy(&energy.gravity, &frame.rotation, &frame.origin, axes);
     CatalogueEntry {
         element: Element::Counterweight {
             body,
@@ -149,16 +189,11 @@ fn spring(
     axes: &[usize],
 ) -> CatalogueEntry {
     let frame = &energy.bodies[body];
-    let (other_rotation, other_origin, other_number, other_name) = match other {
-        Attachment::Base => (
-            PolyMat3::identity(),
-            PolyVec3::zero(),
-            0,
-            "base".to_string(),
-        ),
+    let (other_frame, other_number, other_name) = match other {
+        Attachment::Base => (None, 0, "base".to_string()),
         Attachment::Body(s) => {
             let f = &energy.bodies[s];
-            (f.rotation.clone(), f.origin.clone(), s + 1, f.name.clone())
+            (Some((&f.rotation, &f.origin)), s + 1, f.name.clone())
         }
     };
     // `K43`; with ten or more members the numbers need a separator: `K10,3`.
@@ -167,23 +202,19 @@ fn spring(
     } else {
         format!("K{}{}", body + 1, other_number)
     };
-    let d = frame.origin.sub(&other_origin);
     let mut variables = vec![label.clone()];
-    let mut polys = vec![d.dot(&d).scale(0.5)];
     for &k in axes {
         variables.push(format!("{label}·a{}", AXIS[k]));
-        polys.push(frame.rotation.column(k).dot(&d));
     }
     for &l in axes {
         variables.push(format!("{label}·b{}", AXIS[l]));
-        polys.push(-other_rotation.column(l).dot(&d));
     }
     for &k in axes {
         for &l in axes {
             variables.push(format!("{label}·a{}·b{}", AXIS[k], AXIS[l]));
-            polys.push(-frame.rotation.column(k).dot(&other_rotation.column(l)));
         }
     }
+    let polys = spring_energy((&frame.rotation, &frame.origin), other_frame, axes);
     CatalogueEntry {
         element: Element::Spring {
             body,

@@ -4,6 +4,7 @@
 //! Kept separate from the case model so that tests can build small mechanisms by hand and so that
 //! the search depends only on poses and energies, never on how they were described.
 
+use counterpoise_model::ExactMechanism;
 use counterpoise_symbolic::{PolyMat3, PolyVec3, TrigPoly, VarKind};
 
 /// The symbolic world pose of one body: `x_world = origin + rotation · x_body`.
@@ -27,6 +28,9 @@ pub struct MechanismEnergy {
     pub bodies: Vec<BodyFrame>,
     /// Gravitational potential energy of the unbalanced mechanism (J).
     pub unbalanced: TrigPoly,
+    /// The same mechanism in exact rationals, or why its numbers cannot be taken exactly (the
+    /// search then decides numerically and says so).
+    pub exact: Result<ExactMechanism, String>,
 }
 
 impl MechanismEnergy {

@@ -18,6 +18,7 @@
 pub mod element;
 pub mod energy;
 pub mod enumerate;
+pub mod exact;
 pub mod linear;
 pub mod model_input;
 pub mod realize;

@@ -27,6 +27,7 @@ pub fn mechanism_energy(model: &Model) -> MechanismEnergy {
             })
             .collect(),
         unbalanced: model.potential_energy(PayloadMode::InBalance),
+        exact: counterpoise_model::exact_mechanism(model).map_err(|e| e.to_string()),
     }
 }
 

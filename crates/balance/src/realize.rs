@@ -31,6 +31,23 @@ pub struct RealizationHints {
     pub length: f64,
 }
 
+/// A witness's masses and stiffnesses must be at least this fraction of the typical scale
+/// ([`RealizationHints::mass`], [`RealizationHints::stiffness`]): a "balance" carried by a
+/// 3·10⁻⁹ N/m spring is a numerical artefact, not a part anyone can build.
+pub const FLOOR_FRACTION: f64 = 1e-6;
+
+impl RealizationHints {
+    /// Smallest counterweight mass a witness may have (kg).
+    pub fn mass_floor(&self) -> f64 {
+        FLOOR_FRACTION * self.mass
+    }
+
+    /// Smallest spring stiffness a witness may have (N/m).
+    pub fn stiffness_floor(&self) -> f64 {
+        FLOOR_FRACTION * self.stiffness
+    }
+}
+
 impl Default for RealizationHints {
     fn default() -> Self {
         RealizationHints {
@@ -96,13 +113,30 @@ struct Slot<'a> {
     unknown: usize,
 }
 
-/// Tries to find physical parameters in the solution set of `solution`.
+/// Tries to find physical parameters in the solution set of `solution` (the numeric path: its
+/// proofs are decided in floating point).
 pub fn realize(
     solution: &LinearSolution,
     b: &DVector<f64>,
     entries: &[(usize, &CatalogueEntry)],
     hints: RealizationHints,
 ) -> Realization {
+    if let Some(proof) = numeric_proofs(solution, b, entries) {
+        return proof;
+    }
+    match find_witness(solution, b, entries, hints) {
+        Ok(witness) => Realization::Found(witness),
+        Err(reason) => Realization::GaveUp(reason),
+    }
+}
+
+/// Proofs of unrealizability read off a floating-point solution set: a fixed mass or stiffness
+/// that is not positive, or the rank-one contradiction.
+pub fn numeric_proofs(
+    solution: &LinearSolution,
+    b: &DVector<f64>,
+    entries: &[(usize, &CatalogueEntry)],
+) -> Option<Realization> {
     let b_norm = b.norm();
     // Proofs from the linear stage first.
     for (k, (_, entry)) in entries.iter().enumerate() {
@@ -114,39 +148,46 @@ pub fn realize(
             let zero = scaled.abs() <= 1e-7 * b_norm.max(1.0);
             match entry.element {
                 Element::Counterweight { .. } if zero => {
-                    return Realization::Impossible(format!(
+                    return Some(Realization::Impossible(format!(
                         "{}: mass must be zero while m·r is not: no counterweight does that",
                         entry.label
-                    ));
+                    )));
                 }
                 Element::Counterweight { .. } if value < 0.0 => {
-                    return Realization::Impossible(format!(
+                    return Some(Realization::Impossible(format!(
                         "{}: mass must be negative ({value:.4} kg)",
                         entry.label
-                    ));
+                    )));
                 }
                 Element::Spring { .. } if zero => {
-                    return Realization::Degenerate(format!(
+                    return Some(Realization::Degenerate(format!(
                         "{}: stiffness must be zero while K·a or K·b is not: the element would act \
                          as a constant force, not a spring",
                         entry.label
-                    ));
+                    )));
                 }
                 Element::Spring { .. } if value < 0.0 => {
-                    return Realization::Impossible(format!(
+                    return Some(Realization::Impossible(format!(
                         "{}: stiffness must be negative ({value:.4} N/m)",
                         entry.label
-                    ));
+                    )));
                 }
                 _ => {}
             }
         }
     }
 
-    if let Some(reason) = rank_one_contradiction(solution, entries) {
-        return Realization::Impossible(reason);
-    }
+    rank_one_contradiction(solution, entries).map(Realization::Impossible)
+}
 
+/// Looks for physical parameters (every mass and stiffness at least its floor) in the solution
+/// set by Levenberg–Marquardt from deterministic starts; the reason when none is found.
+pub fn find_witness(
+    solution: &LinearSolution,
+    b: &DVector<f64>,
+    entries: &[(usize, &CatalogueEntry)],
+    hints: RealizationHints,
+) -> Result<Witness, String> {
     let mut slots = Vec::new();
     let mut unknowns = 0;
     for (k, (entry_index, entry)) in entries.iter().enumerate() {
@@ -169,6 +210,7 @@ pub fn realize(
     // Fixed seed: starting points must not depend on thread count or on run.
     let mut rng = SplitMix64::new(0x5eed_ba1a_2ce0_0001);
     let mut best = f64::INFINITY;
+    let mut small: Option<String> = None;
     for start in 0..STARTS {
         let y0 = problem.start(solution, hints, start, &mut rng);
         // First towards a plausible balanced point, then onto the exact balance from there.
@@ -176,12 +218,37 @@ pub fn realize(
         let (y, residual) = problem.levenberg_marquardt(plausible, 0.0, MAX_ITERATIONS);
         best = best.min(residual);
         if residual <= SOLVED_TOL {
-            return Realization::Found(problem.witness(&y));
+            let witness = problem.witness(&y);
+            match below_floor(&witness, hints) {
+                None => return Ok(witness),
+                Some(what) => small = Some(what),
+            }
         }
     }
-    Realization::GaveUp(format!(
-        "no physical parameters found from {STARTS} starts (best relative residual {best:.2e})"
-    ))
+    Err(match small {
+        Some(what) => format!(
+            "the only physical parameters found have {what}, below the floor of {FLOOR_FRACTION:e} \
+             of the typical scale"
+        ),
+        None => format!(
+            "no physical parameters found from {STARTS} starts (best relative residual {best:.2e})"
+        ),
+    })
+}
+
+/// The first mass or stiffness of the witness below its floor, described.
+fn below_floor(witness: &Witness, hints: RealizationHints) -> Option<String> {
+    for cw in &witness.counterweights {
+        if !(cw.mass >= hints.mass_floor()) {
+            return Some(format!("a mass of {:.3e} kg", cw.mass));
+        }
+    }
+    for spring in &witness.springs {
+        if !(spring.stiffness >= hints.stiffness_floor()) {
+            return Some(format!("a stiffness of {:.3e} N/m", spring.stiffness));
+        }
+    }
+    None
 }
 
 /// Starting points per variant. On the palletizer at Dmax = 3, 1156 of 1167 balanced variants

@@ -4,7 +4,12 @@
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
+use counterpoise_symbolic::{Rational, rational_to_f64};
+use num_traits::Signed;
+
 use crate::element::{CatalogueEntry, Element};
+use crate::exact::positivity::{self, Bound};
+use crate::exact::{ExactSolution, exact_text};
 use crate::linear::{FIXED_TOL, LinearSolution};
 
 /// One free direction of the balanced family: moving along it keeps the energy constant.
@@ -30,6 +35,25 @@ pub fn variable_units(entry: &CatalogueEntry) -> Vec<&'static str> {
             .chain(std::iter::repeat_n("N·m", axes_a.len() * axes_b.len()))
             .collect(),
     }
+}
+
+/// A value with six significant digits, without trailing zeros: `228.625`, `1.23457e-7`.
+pub fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor();
+    if !(-4.0..6.0).contains(&magnitude) {
+        return format!("{x:.5e}");
+    }
+    let decimals = (5.0 - magnitude).max(0.0) as usize;
+    let s = format!("{x:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
+    if s == "-0" { "0".to_string() } else { s }
 }
 
 fn format_number(x: f64) -> String {
@@ -153,4 +177,87 @@ pub fn free_directions(
             }
         })
         .collect()
+}
+
+/// The balance relations of an exact solution, solved for the earliest variable of each and
+/// written exactly: `m4 = 1829/8 (228.625) kg`, `K43·ax − 1/4 (0.25)·K43·bx = 0 N`.
+pub fn exact_relations(solution: &ExactSolution, names: &[String], units: &[&str]) -> Vec<String> {
+    solution
+        .echelon
+        .relations()
+        .into_iter()
+        .map(|(pivot, terms, value)| {
+            let mut lhs = names[pivot].clone();
+            for (j, c) in terms {
+                let sign = if c.is_negative() { "−" } else { "+" };
+                let magnitude = c.abs();
+                if magnitude == Rational::from_integer(1.into()) {
+                    lhs.push_str(&format!(" {sign} {}", names[j]));
+                } else {
+                    lhs.push_str(&format!(" {sign} {}·{}", exact_text(&magnitude), names[j]));
+                }
+            }
+            format!("{lhs} = {} {}", exact_text(&value), units[pivot])
+        })
+        .collect()
+}
+
+/// The interval a lifted variable can take over the balanced family while every mass and
+/// stiffness is positive.
+#[derive(Clone, Debug, Serialize)]
+pub struct AdmissibleRange {
+    pub variable: String,
+    pub unit: &'static str,
+    /// `None`: unbounded below.
+    pub low: Option<f64>,
+    /// `None`: unbounded above.
+    pub high: Option<f64>,
+    /// Exact interval, e.g. `(0, 9/28 (0.321429)]`.
+    pub interval: String,
+}
+
+fn interval_text(low: &Option<Bound>, high: &Option<Bound>) -> String {
+    let open = match low {
+        Some(b) if b.closed => format!("[{}", exact_text(&b.value)),
+        Some(b) => format!("({}", exact_text(&b.value)),
+        None => "(−∞".to_string(),
+    };
+    let close = match high {
+        Some(b) if b.closed => format!("{}]", exact_text(&b.value)),
+        Some(b) => format!("{})", exact_text(&b.value)),
+        None => "+∞)".to_string(),
+    };
+    format!("{open}, {close}")
+}
+
+/// Ranges of every mass, stiffness, first moment `m·r` and spring moment `K·a`, `K·b` (the
+/// products `K·a·b` are left out: they follow from the others) over the positive family.
+pub fn admissible_ranges(
+    solution: &ExactSolution,
+    entries: &[(usize, &CatalogueEntry)],
+    names: &[String],
+    units: &[&'static str],
+) -> Vec<AdmissibleRange> {
+    let heads = solution.heads();
+    let mut out = Vec::new();
+    for (k, (_, entry)) in entries.iter().enumerate() {
+        let range = solution.element_range(k);
+        let count = match &entry.element {
+            Element::Counterweight { axes, .. } => 1 + axes.len(),
+            Element::Spring { axes_a, axes_b, .. } => 1 + axes_a.len() + axes_b.len(),
+        };
+        for j in range.start..range.start + count {
+            let Ok(r) = positivity::range(&heads, &solution.affine(j)) else {
+                continue;
+            };
+            out.push(AdmissibleRange {
+                variable: names[j].clone(),
+                unit: units[j],
+                low: r.low.as_ref().map(|b| rational_to_f64(&b.value)),
+                high: r.high.as_ref().map(|b| rational_to_f64(&b.value)),
+                interval: interval_text(&r.low, &r.high),
+            });
+        }
+    }
+    out
 }

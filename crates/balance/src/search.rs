@@ -5,28 +5,35 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::element::{Attachment, Catalogue, Element};
+use crate::element::{Attachment, Catalogue, CatalogueEntry, Element};
 use crate::energy::MechanismEnergy;
 use crate::enumerate::variants;
-use crate::linear::{LiftedBasis, solve};
-use crate::realize::{Realization, RealizationHints, Witness, realize};
-use crate::relations::{FreeDirection, balance_relations, free_directions, variable_units};
+use crate::exact::{ExactBasis, ExactSolution, positivity, rank_one};
+use crate::linear::{LiftedBasis, LinearSolution, solve};
+use crate::realize::{Realization, RealizationHints, Witness, find_witness, realize};
+use crate::relations::{
+    AdmissibleRange, FreeDirection, admissible_ranges, balance_relations, exact_relations,
+    free_directions, variable_units,
+};
 use crate::verify::{Verification, VerificationSet};
 
 /// What the search concluded about a variant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Status {
-    /// Verified physical parameters exist.
+    /// Verified physical parameters exist, and every element carries part of the load.
     Balanced,
-    /// Balance forces an element to vanish (or a spring to act as a constant force): the variant
-    /// is really a smaller one.
+    /// Verified physical parameters exist, but some element can only idle: it contributes no
+    /// energy in any balancing solution (a spring anchored on a joint axis, a counterweight on a
+    /// fixed point). The variant is really a smaller one plus idle parts; it is realizable.
     Degenerate,
-    /// Lifted parameters exist but no physical ones can (reason given).
+    /// Lifted parameters exist but no physical ones can: a certificate is given (a mass or
+    /// stiffness forced to zero or below, no positive solution, an impossible rank-one spring).
     Unrealizable,
     /// `A_S x = −b` has no solution: no parameters balance this variant.
     Infeasible,
-    /// The realization search gave up, or a witness failed verification (reason given).
+    /// Not decided: a floating-point test was ambiguous, or no witness was found and no proof
+    /// either (reason given). Never a verdict.
     Undecided,
 }
 
@@ -48,6 +55,16 @@ impl Status {
             Status::Undecided => "undecided",
         }
     }
+}
+
+/// Which arithmetic decided a variant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Decision {
+    /// Rational arithmetic: every linear fact is exact.
+    Exact,
+    /// Floating point with an explicit ambiguous zone (the case has an irrational constant).
+    Numeric,
 }
 
 /// Counterweights only, springs only, or both (the paper's three classes).
@@ -88,6 +105,8 @@ pub struct VariantResult {
     pub elements: Vec<ElementRef>,
     pub class: Class,
     pub status: Status,
+    /// Which arithmetic decided the variant.
+    pub decision: Decision,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
     /// Rank of `A_S` and dimension of the balanced family (free lifted parameters).
@@ -98,6 +117,10 @@ pub struct VariantResult {
     /// Labels of installed elements that do not change the energy at all (any parameters work).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub redundant: Vec<String>,
+    /// Labels of elements whose energy contribution is zero in every balancing solution: with a
+    /// positive mass or stiffness they can only idle.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub idle: Vec<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub witness: Option<Witness>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -106,6 +129,10 @@ pub struct VariantResult {
     pub relations: Vec<String>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub free_directions: Vec<FreeDirection>,
+    /// Range of each mass, stiffness and first moment over the balanced family with every mass
+    /// and stiffness positive (exact decision only).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub ranges: Vec<AdmissibleRange>,
 }
 
 /// Settings of a search.
@@ -144,11 +171,20 @@ pub fn search(
     options: SearchOptions,
 ) -> SearchReport {
     let basis = LiftedBasis::build(energy, &catalogue);
+    let exact = energy
+        .exact
+        .as_ref()
+        .ok()
+        .map(|mechanism| ExactBasis::build(mechanism, &catalogue));
     let checks = VerificationSet::new(energy);
     let sets: Vec<Vec<usize>> = variants(catalogue.len(), options.dmax).collect();
+    let bases = Bases {
+        numeric: &basis,
+        exact: exact.as_ref(),
+    };
     let variants = sets
         .par_iter()
-        .map(|set| decide(energy, &catalogue, &basis, &checks, set, options.hints))
+        .map(|set| decide(energy, &catalogue, bases, &checks, set, options.hints))
         .collect();
     SearchReport {
         catalogue,
@@ -156,21 +192,34 @@ pub fn search(
     }
 }
 
-/// Decides one variant: linear consistency, degeneracy, realization, verification.
+/// The lifted bases a decision reads: always the numeric one, and the exact one when the case's
+/// numbers are rational.
+#[derive(Clone, Copy)]
+pub struct Bases<'a> {
+    pub numeric: &'a LiftedBasis,
+    pub exact: Option<&'a ExactBasis>,
+}
+
+/// Decides one variant: linear consistency, degeneracy, realizability, verification — exactly
+/// when the case allows it, numerically otherwise.
 pub fn decide(
     energy: &MechanismEnergy,
     catalogue: &Catalogue,
-    basis: &LiftedBasis,
+    bases: Bases,
     checks: &VerificationSet,
     set: &[usize],
     hints: RealizationHints,
 ) -> VariantResult {
-    let solution = solve(basis, set);
     let entries: Vec<_> = set.iter().map(|&e| (e, &catalogue.entries[e])).collect();
-    let elements = entries
-        .iter()
-        .map(|(e, entry)| element_ref(energy, *e, entry))
-        .collect();
+    let mut result = new_result(energy, &entries);
+    match bases.exact {
+        Some(exact) => decide_exact(bases.numeric, exact, checks, &entries, hints, &mut result),
+        None => decide_numeric(bases.numeric, checks, &entries, hints, &mut result),
+    }
+    result
+}
+
+fn new_result(energy: &MechanismEnergy, entries: &[(usize, &CatalogueEntry)]) -> VariantResult {
     let springs = entries
         .iter()
         .filter(|(_, e)| matches!(e.element, Element::Spring { .. }))
@@ -180,26 +229,301 @@ pub fn decide(
         n if n == entries.len() => Class::Springs,
         _ => Class::Hybrid,
     };
-    let mut result = VariantResult {
-        elements,
+    VariantResult {
+        elements: entries
+            .iter()
+            .map(|(e, entry)| element_ref(energy, *e, entry))
+            .collect(),
         class,
         status: Status::Infeasible,
+        decision: Decision::Numeric,
         reason: None,
-        rank: solution.rank,
-        nullity: solution.nullspace.ncols(),
-        linear_residual: solution.residual,
+        rank: 0,
+        nullity: 0,
+        linear_residual: 0.0,
         redundant: Vec::new(),
+        idle: Vec::new(),
         witness: None,
         verification: None,
         relations: Vec::new(),
         free_directions: Vec::new(),
+        ranges: Vec::new(),
+    }
+}
+
+fn names_and_units(entries: &[(usize, &CatalogueEntry)]) -> (Vec<String>, Vec<&'static str>) {
+    let names = entries
+        .iter()
+        .flat_map(|(_, e)| e.variables.clone())
+        .collect();
+    let units = entries
+        .iter()
+        .flat_map(|(_, e)| variable_units(e))
+        .collect();
+    (names, units)
+}
+
+/// The exact path: every linear fact and every proof in rational arithmetic; only the witness
+/// is found in floating point, and it is verified by sampling the physical energy.
+fn decide_exact(
+    numeric: &LiftedBasis,
+    exact: &ExactBasis,
+    checks: &VerificationSet,
+    entries: &[(usize, &CatalogueEntry)],
+    hints: RealizationHints,
+    result: &mut VariantResult,
+) {
+    result.decision = Decision::Exact;
+    let set: Vec<usize> = entries.iter().map(|(e, _)| *e).collect();
+    let solution = exact.solve(&set);
+    result.rank = solution.rank();
+    if !solution.consistent() {
+        result.linear_residual = solve(numeric, &set).residual;
+        result.reason = Some(format!(
+            "the balance equations have no solution (exact: rank {} of the element columns, \
+             {} with the unbalanced energy)",
+            solution.rank(),
+            solution.rank() + 1
+        ));
+        return;
+    }
+    result.nullity = solution.nullity();
+    for (k, &(e, entry)) in entries.iter().enumerate() {
+        if exact.elements[e]
+            .iter()
+            .flatten()
+            .all(num_traits::Zero::is_zero)
+        {
+            result.redundant.push(entry.label.clone());
+        } else if solution.contribution_forced_zero(exact, k) {
+            result.idle.push(entry.label.clone());
+        }
+    }
+    let (names, units) = names_and_units(entries);
+    result.relations = exact_relations(&solution, &names, &units);
+    let linear = linear_from_exact(numeric, &solution);
+    let positive: Vec<usize> = (0..entries.len()).map(|k| solution.offsets[k]).collect();
+    result.free_directions = free_directions(&linear, &names, &positive);
+
+    if let Some(reason) = exact_proof(exact, &solution, entries) {
+        result.status = Status::Unrealizable;
+        result.reason = Some(reason);
+        return;
+    }
+    result.ranges = admissible_ranges(&solution, entries, &names, &units);
+    // Springs whose anchor balance fixes: W = a₀ βᵀ (or α b₀ᵀ) is then linear; impose it.
+    let (anchors, extra) = fixed_anchor_equations(&solution, entries);
+    let linear = if extra.is_empty() {
+        linear
+    } else {
+        let restricted = exact.solve_with(&set, &extra);
+        let context = format!("with {} fixed by balance, ", anchors.join(" and "));
+        if !restricted.consistent() {
+            result.status = Status::Unrealizable;
+            result.reason = Some(format!(
+                "{context}no spring of that anchor satisfies the balance equations"
+            ));
+            return;
+        }
+        if let Some(reason) = exact_proof(exact, &restricted, entries) {
+            result.status = Status::Unrealizable;
+            result.reason = Some(format!("{context}{reason}"));
+            return;
+        }
+        linear_from_exact(numeric, &restricted)
     };
+    match find_witness(&linear, &numeric.unbalanced, entries, hints) {
+        Ok(witness) => accept_witness(checks, witness, result),
+        Err(reason) => {
+            result.status = Status::Undecided;
+            result.reason = Some(reason);
+        }
+    }
+}
+
+/// Proofs of unrealizability in exact arithmetic: a mass or stiffness fixed at zero or below,
+/// no positive point of the family (Farkas certificate), an impossible rank-one spring.
+fn exact_proof(
+    exact: &ExactBasis,
+    solution: &ExactSolution,
+    entries: &[(usize, &CatalogueEntry)],
+) -> Option<String> {
+    for (k, (_, entry)) in entries.iter().enumerate() {
+        let head = solution.offsets[k];
+        if !solution.is_fixed(head) || solution.fixed_positive(head) {
+            continue;
+        }
+        let value = &solution.particular[head];
+        let (what, unit) = match entry.element {
+            Element::Counterweight { .. } => ("mass", "kg"),
+            Element::Spring { .. } => ("stiffness", "N/m"),
+        };
+        return Some(if num_traits::Zero::is_zero(value) {
+            format!("{}: balance forces its {what} to zero", entry.label)
+        } else {
+            format!(
+                "{}: balance forces its {what} to {} {unit}",
+                entry.label,
+                crate::exact::exact_text(value)
+            )
+        });
+    }
+    let heads = solution.heads();
+    if let Err(certificate) = positivity::strictly_feasible(&heads) {
+        let terms: Vec<String> = certificate
+            .multipliers
+            .iter()
+            .zip(entries)
+            .filter(|(m, _)| !num_traits::Zero::is_zero(*m))
+            .map(|(m, (_, entry))| {
+                if m.is_integer() && *m.numer() == 1.into() {
+                    entry.label.clone()
+                } else {
+                    format!("{}·{}", crate::exact::exact_text(m), entry.label)
+                }
+            })
+            .collect();
+        return Some(format!(
+            "no positive masses and stiffnesses balance it: every solution has {} = {} ≤ 0",
+            terms.join(" + "),
+            crate::exact::exact_text(&certificate.value)
+        ));
+    }
+    let refs: Vec<&CatalogueEntry> = entries.iter().map(|(_, e)| *e).collect();
+    rank_one::contradiction(exact, solution, &refs)
+}
+
+/// For every spring whose anchor `a` (or `b`) balance fixes — `K·a = a₀·K` on the whole family —
+/// the equations `W = a₀ βᵀ` (or `W = α b₀ᵀ`) a physical spring must satisfy, as rows over the
+/// variant's variables; and the anchors, described.
+fn fixed_anchor_equations(
+    solution: &ExactSolution,
+    entries: &[(usize, &CatalogueEntry)],
+) -> (Vec<String>, Vec<Vec<counterpoise_symbolic::Rational>>) {
+    use counterpoise_symbolic::Rational;
+    let n = solution.echelon.columns;
+    let mut anchors = Vec::new();
+    let mut rows = Vec::new();
+    for (k, (_, entry)) in entries.iter().enumerate() {
+        let Element::Spring { axes_a, axes_b, .. } = &entry.element else {
+            continue;
+        };
+        let (na, nb) = (axes_a.len(), axes_b.len());
+        let start = solution.offsets[k];
+        let (alpha, beta, w) = (start + 1, start + 1 + na, start + 1 + na + nb);
+        let describe = |side: &str, v: &[Rational]| {
+            let values: Vec<String> = v.iter().map(crate::exact::exact_text).collect();
+            format!("{}'s anchor {side} = ({})", entry.label, values.join(", "))
+        };
+        let one = Rational::from_integer(1.into());
+        if let Some(a0) = solution.proportional_to(start, alpha..alpha + na) {
+            // W_ij − a0_i β_j = 0
+            for i in 0..na {
+                for j in 0..nb {
+                    let mut row = vec![Rational::from_integer(0.into()); n];
+                    row[w + i * nb + j] = one.clone();
+                    row[beta + j] = -a0[i].clone();
+                    rows.push(row);
+                }
+            }
+            anchors.push(describe("a", &a0));
+        } else if let Some(b0) = solution.proportional_to(start, beta..beta + nb) {
+            for i in 0..na {
+                for j in 0..nb {
+                    let mut row = vec![Rational::from_integer(0.into()); n];
+                    row[w + i * nb + j] = one.clone();
+                    row[alpha + i] = -b0[j].clone();
+                    rows.push(row);
+                }
+            }
+            anchors.push(describe("b", &b0));
+        }
+    }
+    (anchors, rows)
+}
+
+/// The exact family in floating point, for the witness search and the free-direction display.
+fn linear_from_exact(numeric: &LiftedBasis, solution: &ExactSolution) -> LinearSolution {
+    use counterpoise_symbolic::rational_to_f64;
+    use nalgebra::{DMatrix, DVector};
+    let (matrix, offsets) = numeric.system(&solution.elements);
+    let cols = matrix.ncols();
+    let column_scale = DVector::from_iterator(
+        cols,
+        matrix.column_iter().map(|c| {
+            let n = c.norm();
+            if n > 0.0 { n } else { 1.0 }
+        }),
+    );
+    let particular = DVector::from_iterator(cols, solution.particular.iter().map(rational_to_f64));
+    let nullspace = DMatrix::from_fn(cols, solution.nullspace.len(), |j, f| {
+        rational_to_f64(&solution.nullspace[f][j])
+    });
+    let b = &numeric.unbalanced;
+    let residual = (&matrix * &particular + b).norm() / b.norm().max(f64::MIN_POSITIVE);
+    LinearSolution {
+        matrix,
+        offsets,
+        consistent: true,
+        residual,
+        particular,
+        nullspace,
+        rank: solution.rank(),
+        column_scale,
+    }
+}
+
+/// Verifies a witness by sampling the physical energy; balanced (or degenerate, when some
+/// element can only idle) if it passes, undecided if not.
+fn accept_witness(checks: &VerificationSet, witness: Witness, result: &mut VariantResult) {
+    let verification = checks.verify(&witness);
+    if verification.passed {
+        if result.idle.is_empty() {
+            result.status = Status::Balanced;
+        } else {
+            result.status = Status::Degenerate;
+            result.reason = Some(format!(
+                "{} can only idle: {} no energy in any balancing solution, so the variant is \
+                 really a smaller one",
+                result.idle.join(", "),
+                if result.idle.len() == 1 {
+                    "it contributes"
+                } else {
+                    "they contribute"
+                }
+            ));
+        }
+    } else {
+        result.status = Status::Undecided;
+        result.reason = Some(format!(
+            "witness failed verification (relative energy spread {:.2e})",
+            verification.residual
+        ));
+    }
+    result.witness = Some(witness);
+    result.verification = Some(verification);
+}
+
+/// The numeric path, for cases with irrational constants: floating-point consistency and
+/// proofs.
+fn decide_numeric(
+    basis: &LiftedBasis,
+    checks: &VerificationSet,
+    entries: &[(usize, &CatalogueEntry)],
+    hints: RealizationHints,
+    result: &mut VariantResult,
+) {
+    let set: Vec<usize> = entries.iter().map(|(e, _)| *e).collect();
+    let solution = solve(basis, &set);
+    result.rank = solution.rank;
+    result.nullity = solution.nullspace.ncols();
+    result.linear_residual = solution.residual;
     if !solution.consistent {
         result.reason = Some(format!(
             "the balance equations have no solution (relative residual {:.2e})",
             solution.residual
         ));
-        return result;
+        return;
     }
     let b = &basis.unbalanced;
     let b_norm = b.norm();
@@ -207,41 +531,16 @@ pub fn decide(
         if basis.elements[e].iter().all(|&v| v == 0.0) {
             result.redundant.push(entry.label.clone());
         } else if solution.contribution_forced_zero(k, b_norm) {
-            result.status = Status::Degenerate;
-            result.reason = Some(format!(
-                "{} must contribute no energy: the variant is really a smaller one",
-                entry.label
-            ));
-            return result;
+            result.idle.push(entry.label.clone());
         }
     }
-    let names: Vec<String> = entries
-        .iter()
-        .flat_map(|(_, e)| e.variables.clone())
-        .collect();
-    let units: Vec<&str> = entries
-        .iter()
-        .flat_map(|(_, e)| variable_units(e))
-        .collect();
+    let (names, units) = names_and_units(entries);
     let positive: Vec<usize> = (0..entries.len()).map(|k| solution.offsets[k]).collect();
     result.relations = balance_relations(&solution, b, &names, &units);
     result.free_directions = free_directions(&solution, &names, &positive);
 
-    match realize(&solution, b, &entries, hints) {
-        Realization::Found(witness) => {
-            let verification = checks.verify(&witness);
-            if verification.passed {
-                result.status = Status::Balanced;
-            } else {
-                result.status = Status::Undecided;
-                result.reason = Some(format!(
-                    "witness failed verification (relative energy spread {:.2e})",
-                    verification.residual
-                ));
-            }
-            result.witness = Some(witness);
-            result.verification = Some(verification);
-        }
+    match realize(&solution, b, entries, hints) {
+        Realization::Found(witness) => accept_witness(checks, witness, result),
         Realization::Impossible(reason) => {
             result.status = Status::Unrealizable;
             result.reason = Some(reason);
@@ -255,7 +554,6 @@ pub fn decide(
             result.reason = Some(reason);
         }
     }
-    result
 }
 
 fn element_ref(

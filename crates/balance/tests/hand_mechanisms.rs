@@ -36,6 +36,7 @@ fn pendulum(mass: f64, com: f64) -> MechanismEnergy {
         gravity: [0.0, -G, 0.0],
         bodies: frames,
         unbalanced,
+        exact: Err("built by hand with numeric coefficients".to_string()),
     }
 }
 
@@ -133,6 +134,7 @@ fn two_link(l1: f64, m1: f64, c1: f64, m2: f64, c2: f64) -> MechanismEnergy {
         gravity: [0.0, -G, 0.0],
         bodies: frames,
         unbalanced,
+        exact: Err("built by hand with numeric coefficients".to_string()),
     }
 }
 

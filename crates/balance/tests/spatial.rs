@@ -323,6 +323,7 @@ fn mechanism(arm: &Arm) -> MechanismEnergy {
         gravity,
         bodies,
         unbalanced,
+        exact: Err("built by hand with numeric coefficients".to_string()),
     }
 }
 

@@ -19,6 +19,8 @@ pub trait Scalar: Clone + PartialEq + Debug + Default + Send + Sync + 'static {
     fn one() -> Self;
     fn is_zero(&self) -> bool;
     fn from_i64(value: i64) -> Self;
+    /// `numerator / denominator` (`denominator ≠ 0`).
+    fn from_ratio(numerator: i64, denominator: i64) -> Self;
     fn add_ref(&self, other: &Self) -> Self;
     fn mul_ref(&self, other: &Self) -> Self;
     fn neg_ref(&self) -> Self;
@@ -38,6 +40,9 @@ impl Scalar for f64 {
     }
     fn from_i64(value: i64) -> f64 {
         value as f64
+    }
+    fn from_ratio(numerator: i64, denominator: i64) -> f64 {
+        numerator as f64 / denominator as f64
     }
     fn add_ref(&self, other: &f64) -> f64 {
         self + other
@@ -65,6 +70,9 @@ impl Scalar for Rational {
     }
     fn from_i64(value: i64) -> Rational {
         Rational::from_integer(BigInt::from(value))
+    }
+    fn from_ratio(numerator: i64, denominator: i64) -> Rational {
+        Rational::new(BigInt::from(numerator), BigInt::from(denominator))
     }
     fn add_ref(&self, other: &Rational) -> Rational {
         self + other

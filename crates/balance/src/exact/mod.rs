@@ -1,0 +1,304 @@
+//! The exact balance decision: the lifted system `A_S x = −b` over ℚ.
+//!
+//! When every number of the case is rational (see [`counterpoise_model::exact_mechanism`]) the
+//! energy coefficients of the mechanism and of every element are rational, computed by the same
+//! generic formulas as the numeric ones ([`crate::element::counterweight_energy`],
+//! [`crate::element::spring_energy`]). Each row (monomial) of `[A_all | b]` is scaled once by a
+//! positive rational to coprime integers — which changes no solution — and every variant is then
+//! eliminated exactly ([`elimination`]). Rank, consistency, the particular solution, the null
+//! space, "this variable is fixed" and "this contribution vanishes" are facts, not thresholds:
+//! a superset of a consistent set is consistent by construction, and one ulp in an input is a
+//! different rational, never a flipped threshold.
+//!
+//! Positivity of masses and stiffnesses over the family is decided exactly too ([`positivity`]),
+//! with a Farkas certificate when it fails, and the admissible range of each lifted variable is
+//! the projection of the positive family.
+
+pub mod elimination;
+pub mod positivity;
+pub mod rank_one;
+
+use std::collections::BTreeMap;
+
+use num_bigint::BigInt;
+use num_integer::Integer;
+use num_traits::{Signed, Zero};
+
+use counterpoise_model::ExactMechanism;
+use counterpoise_symbolic::{ExactPoly, Monomial, Rational};
+
+use crate::element::{Attachment, Catalogue, Element, counterweight_energy, spring_energy};
+use elimination::{Echelon, eliminate};
+use positivity::Affine;
+
+/// The exact coefficient vectors of the unbalanced energy and of every catalogue element, on one
+/// shared list of monomials, each row scaled to coprime integers.
+#[derive(Clone, Debug)]
+pub struct ExactBasis {
+    /// Non-constant monomials that appear anywhere (the rows).
+    pub monomials: Vec<Monomial>,
+    /// Row-scaled coefficients of the unbalanced energy (`b`).
+    pub unbalanced: Vec<BigInt>,
+    /// Per catalogue entry, per lifted variable: the row-scaled column.
+    pub elements: Vec<Vec<Vec<BigInt>>>,
+}
+
+/// The exact energy polynomials of one catalogue entry, per lifted variable.
+pub fn element_polys(mechanism: &ExactMechanism, element: &Element) -> Vec<ExactPoly> {
+    match element {
+        Element::Counterweight { body, axes } => {
+            let frame = &mechanism.bodies[*body];
+            counterweight_energy(&mechanism.gravity, &frame.rotation, &frame.origin, axes)
+        }
+        Element::Spring {
+            body,
+            other,
+            axes_a,
+            ..
+        } => {
+            let frame = &mechanism.bodies[*body];
+            let other = match other {
+                Attachment::Base => None,
+                Attachment::Body(s) => {
+                    let f = &mechanism.bodies[*s];
+                    Some((&f.rotation, &f.origin))
+                }
+            };
+            spring_energy((&frame.rotation, &frame.origin), other, axes_a)
+        }
+    }
+}
+
+impl ExactBasis {
+    pub fn build(mechanism: &ExactMechanism, catalogue: &Catalogue) -> ExactBasis {
+        let polys: Vec<Vec<ExactPoly>> = catalogue
+            .entries
+            .iter()
+            .map(|entry| element_polys(mechanism, &entry.element))
+            .collect();
+        let mut index: BTreeMap<Monomial, usize> = BTreeMap::new();
+        for poly in std::iter::once(&mechanism.unbalanced).chain(polys.iter().flatten()) {
+            for (m, _) in poly.terms_ref() {
+                if !m.is_one() {
+                    index.entry(*m).or_insert(0);
+                }
+            }
+        }
+        for (row, slot) in index.values_mut().enumerate() {
+            *slot = row;
+        }
+        let rows = index.len();
+        let column = |poly: &ExactPoly| {
+            let mut v = vec![Rational::zero(); rows];
+            for (m, c) in poly.terms_ref() {
+                if let Some(&row) = index.get(m) {
+                    v[row] = c.clone();
+                }
+            }
+            v
+        };
+        let b = column(&mechanism.unbalanced);
+        let columns: Vec<Vec<Vec<Rational>>> = polys
+            .iter()
+            .map(|entry| entry.iter().map(&column).collect())
+            .collect();
+        // One positive factor per row: the lcm of its denominators over the gcd of its
+        // numerators.
+        let mut factors = Vec::with_capacity(rows);
+        for r in 0..rows {
+            let entries = std::iter::once(&b[r]).chain(columns.iter().flatten().map(|c| &c[r]));
+            let (mut lcm, mut gcd) = (BigInt::from(1), BigInt::zero());
+            for q in entries.filter(|q| !q.is_zero()) {
+                lcm = lcm.lcm(q.denom());
+                gcd = gcd.gcd(q.numer());
+            }
+            let gcd = if gcd.is_zero() { BigInt::from(1) } else { gcd };
+            factors.push(Rational::new(lcm, gcd));
+        }
+        let scale = |v: &[Rational]| -> Vec<BigInt> {
+            v.iter()
+                .zip(&factors)
+                .map(|(q, f)| {
+                    let s = q * f;
+                    debug_assert!(s.is_integer());
+                    s.to_integer()
+                })
+                .collect()
+        };
+        ExactBasis {
+            monomials: index.into_keys().collect(),
+            unbalanced: scale(&b),
+            elements: columns
+                .iter()
+                .map(|entry| entry.iter().map(|c| scale(c)).collect())
+                .collect(),
+        }
+    }
+
+    /// Eliminates variant `elements` exactly.
+    pub fn solve(&self, elements: &[usize]) -> ExactSolution {
+        self.solve_with(elements, &[])
+    }
+
+    /// Eliminates variant `elements` exactly with extra homogeneous equations `e·x = 0` (rows
+    /// over the variant's lifted variables), e.g. a spring's `W = a₀ βᵀ` once its anchor is known.
+    pub fn solve_with(&self, elements: &[usize], extra: &[Vec<Rational>]) -> ExactSolution {
+        let mut offsets = Vec::with_capacity(elements.len() + 1);
+        let mut columns: Vec<&Vec<BigInt>> = Vec::new();
+        for &e in elements {
+            offsets.push(columns.len());
+            columns.extend(&self.elements[e]);
+        }
+        offsets.push(columns.len());
+        let n = columns.len();
+        let rows: Vec<Vec<BigInt>> = (0..self.monomials.len())
+            .filter(|&r| !self.unbalanced[r].is_zero() || columns.iter().any(|c| !c[r].is_zero()))
+            .map(|r| {
+                let mut row: Vec<BigInt> = columns.iter().map(|c| c[r].clone()).collect();
+                row.push(-self.unbalanced[r].clone());
+                row
+            })
+            .collect();
+        let mut rows = rows;
+        for e in extra {
+            let lcm = e.iter().fold(BigInt::from(1), |acc, q| acc.lcm(q.denom()));
+            let mut row: Vec<BigInt> = e
+                .iter()
+                .map(|q| (q * Rational::from_integer(lcm.clone())).to_integer())
+                .collect();
+            row.push(BigInt::zero());
+            rows.push(row);
+        }
+        let echelon = eliminate(&rows, n);
+        let (particular, nullspace) = if echelon.consistent {
+            (echelon.particular(), echelon.nullspace())
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        ExactSolution {
+            elements: elements.to_vec(),
+            offsets,
+            echelon,
+            particular,
+            nullspace,
+        }
+    }
+}
+
+/// One variant's exact solution set `x_p + N z`, or the fact that it is empty.
+#[derive(Clone, Debug)]
+pub struct ExactSolution {
+    /// Catalogue entries of the variant.
+    pub elements: Vec<usize>,
+    /// Start of each element's variables in `x`, plus the total at the end.
+    pub offsets: Vec<usize>,
+    pub echelon: Echelon,
+    /// Particular solution (free variables zero); empty when inconsistent.
+    pub particular: Vec<Rational>,
+    /// Basis of the free directions; empty when inconsistent.
+    pub nullspace: Vec<Vec<Rational>>,
+}
+
+impl ExactSolution {
+    pub fn consistent(&self) -> bool {
+        self.echelon.consistent
+    }
+
+    pub fn rank(&self) -> usize {
+        self.echelon.rank()
+    }
+
+    pub fn nullity(&self) -> usize {
+        self.echelon.columns - self.echelon.rank()
+    }
+
+    /// The variables of element `k` of the variant.
+    pub fn element_range(&self, k: usize) -> std::ops::Range<usize> {
+        self.offsets[k]..self.offsets[k + 1]
+    }
+
+    /// Whether variable `j` takes the same value in every solution.
+    pub fn is_fixed(&self, j: usize) -> bool {
+        self.nullspace.iter().all(|v| v[j].is_zero())
+    }
+
+    /// Variable `j` as an affine function of the free parameters `z`.
+    pub fn affine(&self, j: usize) -> Affine {
+        Affine {
+            constant: self.particular[j].clone(),
+            coefficients: self.nullspace.iter().map(|v| v[j].clone()).collect(),
+        }
+    }
+
+    /// Whether element `k`'s energy contribution `A_k x_k` is zero in every solution.
+    pub fn contribution_forced_zero(&self, basis: &ExactBasis, k: usize) -> bool {
+        let columns = &basis.elements[self.elements[k]];
+        let range = self.element_range(k);
+        let vanishes = |x: &[Rational]| {
+            (0..basis.monomials.len()).all(|r| {
+                let mut sum = Rational::zero();
+                for (c, j) in columns.iter().zip(range.clone()) {
+                    if !c[r].is_zero() && !x[j].is_zero() {
+                        sum += &x[j] * Rational::from_integer(c[r].clone());
+                    }
+                }
+                sum.is_zero()
+            })
+        };
+        vanishes(&self.particular) && self.nullspace.iter().all(|v| vanishes(v))
+    }
+
+    /// `Some(v)` when variables `range` equal `v·K(z)` on the whole family for the constant
+    /// vector `v` (the spring's anchor is fixed by balance), `K` being variable `stiffness`.
+    pub fn proportional_to(
+        &self,
+        stiffness: usize,
+        range: std::ops::Range<usize>,
+    ) -> Option<Vec<Rational>> {
+        let k = self.affine(stiffness);
+        let pivot = k.coefficients.iter().position(|c| !c.is_zero());
+        range
+            .map(|j| {
+                let f = self.affine(j);
+                let ratio = match pivot {
+                    Some(u) => &f.coefficients[u] / &k.coefficients[u],
+                    None if k.constant.is_zero() => return None,
+                    None => &f.constant / &k.constant,
+                };
+                let same = f.constant == &ratio * &k.constant
+                    && f.coefficients
+                        .iter()
+                        .zip(&k.coefficients)
+                        .all(|(a, b)| *a == &ratio * b);
+                same.then_some(ratio)
+            })
+            .collect()
+    }
+
+    /// Heads (masses and stiffnesses) of the variant's elements as affine functions of `z`.
+    pub fn heads(&self) -> Vec<Affine> {
+        (0..self.elements.len())
+            .map(|k| self.affine(self.offsets[k]))
+            .collect()
+    }
+
+    /// `true` when the fixed value of variable `j` is strictly positive.
+    pub fn fixed_positive(&self, j: usize) -> bool {
+        self.particular[j].is_positive()
+    }
+}
+
+/// Writes a rational exactly, with its decimal value beside it when it is not an integer:
+/// `1829/8 (228.625)`.
+pub fn exact_text(q: &Rational) -> String {
+    if q.is_integer() {
+        format!("{}", q.numer())
+    } else {
+        format!(
+            "{}/{} ({})",
+            q.numer(),
+            q.denom(),
+            crate::relations::significant(counterpoise_symbolic::rational_to_f64(q))
+        )
+    }
+}

@@ -1,0 +1,301 @@
+//! Exact linear feasibility over the balanced family: can every mass and stiffness be positive,
+//! and how far can each lifted variable range while they are?
+//!
+//! The family is `x = x_p + N z`; each installed element's mass or stiffness is an affine
+//! function `h_i(z)`, and positivity asks for `z` with every `h_i(z) > 0`. Fourier–Motzkin
+//! elimination decides this exactly in rationals (a variant has at most `Dmax` such constraints,
+//! so the elimination stays tiny), and carries the non-negative multipliers of every derived
+//! inequality: when it ends in `0 < c ≤ 0`, those multipliers are a Farkas certificate,
+//! `Σ λ_i h_i(z) ≡ c ≤ 0`, that anyone can check by hand.
+
+use num_traits::{Signed, Zero};
+
+use counterpoise_symbolic::Rational;
+
+/// An affine function `constant + Σ coefficients[k]·z_k`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Affine {
+    pub constant: Rational,
+    pub coefficients: Vec<Rational>,
+}
+
+impl Affine {
+    fn combine(&self, a: &Rational, other: &Affine, b: &Rational) -> Affine {
+        Affine {
+            constant: &self.constant * a + &other.constant * b,
+            coefficients: self
+                .coefficients
+                .iter()
+                .zip(&other.coefficients)
+                .map(|(x, y)| x * a + y * b)
+                .collect(),
+        }
+    }
+
+    pub fn is_constant(&self) -> bool {
+        self.coefficients.iter().all(Zero::is_zero)
+    }
+}
+
+/// `f(z) > 0` (strict) or `f(z) ≥ 0`, with the multipliers of the original constraints that
+/// produced it.
+#[derive(Clone, Debug)]
+struct Inequality {
+    f: Affine,
+    strict: bool,
+    multipliers: Vec<Rational>,
+}
+
+/// Why no `z` satisfies the constraints: `Σ multipliers[i]·h_i(z) ≡ value` for every `z`, with
+/// non-negative multipliers, while the constraints demand it be positive.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Infeasibility {
+    pub multipliers: Vec<Rational>,
+    pub value: Rational,
+}
+
+/// Eliminates every variable but the last `keep` ones; `Err` on a contradiction.
+fn eliminate(mut rows: Vec<Inequality>, keep: usize) -> Result<Vec<Inequality>, Infeasibility> {
+    let n = rows.first().map_or(0, |r| r.f.coefficients.len());
+    for var in 0..n.saturating_sub(keep) {
+        let (mut positive, mut negative, mut rest) = (Vec::new(), Vec::new(), Vec::new());
+        for row in rows {
+            let c = &row.f.coefficients[var];
+            if c.is_zero() {
+                rest.push(row);
+            } else if c.is_positive() {
+                positive.push(row);
+            } else {
+                negative.push(row);
+            }
+        }
+        for p in &positive {
+            for q in &negative {
+                // (−q_var)·p + p_var·q cancels the variable; both factors are positive.
+                let a = -q.f.coefficients[var].clone();
+                let b = p.f.coefficients[var].clone();
+                rest.push(Inequality {
+                    f: p.f.combine(&a, &q.f, &b),
+                    strict: p.strict || q.strict,
+                    multipliers: p
+                        .multipliers
+                        .iter()
+                        .zip(&q.multipliers)
+                        .map(|(x, y)| x * &a + y * &b)
+                        .collect(),
+                });
+            }
+        }
+        rows = rest;
+        check_constants(&rows)?;
+    }
+    Ok(rows)
+}
+
+/// A row without variables must hold as it stands.
+fn check_constants(rows: &[Inequality]) -> Result<(), Infeasibility> {
+    for row in rows.iter().filter(|r| r.f.is_constant()) {
+        let c = &row.f.constant;
+        let violated = if row.strict {
+            !c.is_positive()
+        } else {
+            c.is_negative()
+        };
+        if violated {
+            return Err(Infeasibility {
+                multipliers: row.multipliers.clone(),
+                value: c.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn strict_rows(constraints: &[Affine]) -> Vec<Inequality> {
+    let m = constraints.len();
+    constraints
+        .iter()
+        .enumerate()
+        .map(|(i, f)| Inequality {
+            f: f.clone(),
+            strict: true,
+            multipliers: (0..m)
+                .map(|j| {
+                    if i == j {
+                        Rational::from_integer(1.into())
+                    } else {
+                        Rational::zero()
+                    }
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+/// Whether some `z` makes every constraint strictly positive; the certificate when none does.
+pub fn strictly_feasible(constraints: &[Affine]) -> Result<(), Infeasibility> {
+    let rows = strict_rows(constraints);
+    check_constants(&rows)?;
+    eliminate(rows, 0).map(|_| ())
+}
+
+/// One end of an interval: `None` for ±∞.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bound {
+    pub value: Rational,
+    /// Whether the end is attained.
+    pub closed: bool,
+}
+
+/// The range of an affine function over `{z : every constraint > 0}` (assumed non-empty).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Range {
+    pub low: Option<Bound>,
+    pub high: Option<Bound>,
+}
+
+/// The range of `target(z)` while every constraint is strictly positive.
+pub fn range(constraints: &[Affine], target: &Affine) -> Result<Range, Infeasibility> {
+    let Some(pivot) = target.coefficients.iter().position(|c| !c.is_zero()) else {
+        strictly_feasible(constraints)?;
+        let fixed = Bound {
+            value: target.constant.clone(),
+            closed: true,
+        };
+        return Ok(Range {
+            low: Some(fixed.clone()),
+            high: Some(fixed),
+        });
+    };
+    // z_pivot = (t − target.constant − Σ_{k≠pivot} g_k z_k) / g_pivot; the variables become
+    // (z without pivot, t), t last.
+    let g = &target.coefficients;
+    let substitute = |f: &Affine| -> Affine {
+        let ratio = &f.coefficients[pivot] / &g[pivot];
+        let mut coefficients: Vec<Rational> = f
+            .coefficients
+            .iter()
+            .zip(g)
+            .enumerate()
+            .filter(|(k, _)| *k != pivot)
+            .map(|(_, (fk, gk))| fk - &ratio * gk)
+            .collect();
+        coefficients.push(ratio.clone());
+        Affine {
+            constant: &f.constant - &ratio * &target.constant,
+            coefficients,
+        }
+    };
+    let transformed: Vec<Affine> = constraints.iter().map(substitute).collect();
+    let rows = strict_rows(&transformed);
+    check_constants(&rows)?;
+    let rows = eliminate(rows, 1)?;
+    let mut low: Option<Bound> = None;
+    let mut high: Option<Bound> = None;
+    for row in rows {
+        let a = row
+            .f
+            .coefficients
+            .last()
+            .cloned()
+            .unwrap_or_else(Rational::zero);
+        if a.is_zero() {
+            continue; // checked as a constant row by the elimination
+        }
+        // a t + c > 0 (or ≥): t > −c/a when a > 0, t < −c/a when a < 0.
+        let value = -&row.f.constant / &a;
+        let bound = Bound {
+            value,
+            closed: !row.strict,
+        };
+        if a.is_positive() {
+            let tighter = low
+                .as_ref()
+                .is_none_or(|l| bound.value > l.value || (bound.value == l.value && !bound.closed));
+            if tighter {
+                low = Some(bound);
+            }
+        } else {
+            let tighter = high
+                .as_ref()
+                .is_none_or(|h| bound.value < h.value || (bound.value == h.value && !bound.closed));
+            if tighter {
+                high = Some(bound);
+            }
+        }
+    }
+    Ok(Range { low, high })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_bigint::BigInt;
+
+    fn q(n: i64) -> Rational {
+        Rational::from_integer(BigInt::from(n))
+    }
+
+    fn affine(constant: i64, coefficients: &[i64]) -> Affine {
+        Affine {
+            constant: q(constant),
+            coefficients: coefficients.iter().map(|&c| q(c)).collect(),
+        }
+    }
+
+    #[test]
+    fn opposite_stiffnesses_cannot_both_be_positive() {
+        // K21 = z, K51 = −z: the relation K21 + K51 = 0 of the palletizer's {K21, K51, m4}.
+        let constraints = [affine(0, &[1]), affine(0, &[-1]), affine(5, &[0])];
+        let err = strictly_feasible(&constraints).unwrap_err();
+        // 1·K21 + 1·K51 ≡ 0 — the certificate is the relation itself.
+        assert_eq!(err.multipliers, vec![q(1), q(1), q(0)]);
+        assert_eq!(err.value, q(0));
+    }
+
+    #[test]
+    fn a_shared_load_has_the_hand_computed_share() {
+        // K1 = z1, K2 = 9 − z1 − 28 z2, m = z2: K1 ranges over (0, 9), K2 too, m over (0, 9/28).
+        let constraints = [
+            affine(0, &[1, 0]),
+            affine(9, &[-1, -28]),
+            affine(0, &[0, 1]),
+        ];
+        assert!(strictly_feasible(&constraints).is_ok());
+        let m = range(&constraints, &affine(0, &[0, 1])).unwrap();
+        let nine_28 = Rational::new(BigInt::from(9), BigInt::from(28));
+        assert_eq!(
+            m.low,
+            Some(Bound {
+                value: q(0),
+                closed: false
+            })
+        );
+        assert_eq!(
+            m.high,
+            Some(Bound {
+                value: nine_28,
+                closed: false
+            })
+        );
+        // A combination that grows without bound in one direction.
+        let free = range(&[affine(0, &[1, 0])], &affine(1, &[1, 1])).unwrap();
+        assert_eq!(free.low, None);
+        assert_eq!(free.high, None);
+        let half_line = range(&[affine(-2, &[1])], &affine(0, &[3])).unwrap();
+        assert_eq!(
+            half_line.low,
+            Some(Bound {
+                value: q(6),
+                closed: false
+            })
+        );
+        assert_eq!(half_line.high, None);
+    }
+
+    #[test]
+    fn a_fixed_negative_mass_is_infeasible() {
+        let err = strictly_feasible(&[affine(-3, &[])]).unwrap_err();
+        assert_eq!(err.value, q(-3));
+    }
+}

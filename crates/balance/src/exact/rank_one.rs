@@ -1,0 +1,192 @@
+//! The exact rank-one test: a spring's lifted `W = α βᵀ / K` shown impossible on the family.
+//!
+//! A spring is realizable only where `A_W (K·W − α βᵀ) = 0` (just the combinations of `W` that
+//! change the energy matter). Along the family `x = x_p + N z` every component of that residual
+//! is a quadratic polynomial in `z`, computed here exactly. When it is identically
+//! `c₀ + c₁·K(z)` — no quadratic part, a linear part parallel to `K`'s — a spring exists only at
+//! `K = −c₀/c₁`; if that value is not a positive stiffness the whole family admits (or two rows
+//! demand different values, or `c₁ = 0 ≠ c₀`), no spring does: a proof, not a threshold.
+
+use num_traits::{Signed, Zero};
+
+use counterpoise_symbolic::Rational;
+
+use super::positivity::{self, Affine};
+use super::{ExactBasis, ExactSolution, exact_text};
+use crate::element::{CatalogueEntry, Element};
+
+/// A quadratic polynomial in `z`: constant, linear and (unsymmetrised) quadratic coefficients.
+struct Quadratic {
+    constant: Rational,
+    linear: Vec<Rational>,
+    quadratic: Vec<Vec<Rational>>,
+}
+
+impl Quadratic {
+    fn zero(n: usize) -> Quadratic {
+        Quadratic {
+            constant: Rational::zero(),
+            linear: vec![Rational::zero(); n],
+            quadratic: vec![vec![Rational::zero(); n]; n],
+        }
+    }
+
+    /// `self += s · f · g`.
+    fn add_product(&mut self, s: &Rational, f: &Affine, g: &Affine) {
+        if s.is_zero() {
+            return;
+        }
+        self.constant += s * &f.constant * &g.constant;
+        let n = self.linear.len();
+        for u in 0..n {
+            let lin = &f.constant * &g.coefficients[u] + &g.constant * &f.coefficients[u];
+            if !lin.is_zero() {
+                self.linear[u] += s * lin;
+            }
+            if f.coefficients[u].is_zero() {
+                continue;
+            }
+            let fu = s * &f.coefficients[u];
+            for v in 0..n {
+                if !g.coefficients[v].is_zero() {
+                    self.quadratic[u][v] += &fu * &g.coefficients[v];
+                }
+            }
+        }
+    }
+
+    fn has_quadratic_part(&self) -> bool {
+        let n = self.linear.len();
+        (0..n).any(|u| (u..n).any(|v| !(&self.quadratic[u][v] + &self.quadratic[v][u]).is_zero()))
+    }
+}
+
+/// What one residual row demands of the stiffness.
+enum Demand {
+    /// Not of the form `c₀ + c₁ K`: this test says nothing.
+    Unknown,
+    /// Zero everywhere: no condition.
+    Nothing,
+    /// Never zero.
+    Impossible(Rational),
+    /// Zero exactly at `K = value`.
+    Stiffness(Rational),
+}
+
+fn demand(residual: &Quadratic, stiffness: &Affine) -> Demand {
+    if residual.has_quadratic_part() {
+        return Demand::Unknown;
+    }
+    let c1 = match stiffness.coefficients.iter().position(|c| !c.is_zero()) {
+        Some(u) => &residual.linear[u] / &stiffness.coefficients[u],
+        None => Rational::zero(),
+    };
+    let parallel = residual
+        .linear
+        .iter()
+        .zip(&stiffness.coefficients)
+        .all(|(r, k)| *r == &c1 * k);
+    if !parallel {
+        return Demand::Unknown;
+    }
+    let c0 = &residual.constant - &c1 * &stiffness.constant;
+    match (c0.is_zero(), c1.is_zero()) {
+        (true, true) => Demand::Nothing,
+        (false, true) => Demand::Impossible(c0),
+        (_, false) => Demand::Stiffness(-c0 / c1),
+    }
+}
+
+/// The proof that some spring of the variant cannot be rank-one, when this test finds one.
+pub fn contradiction(
+    basis: &ExactBasis,
+    solution: &ExactSolution,
+    entries: &[&CatalogueEntry],
+) -> Option<String> {
+    let heads = solution.heads();
+    let n = solution.nullity();
+    for (k, entry) in entries.iter().enumerate() {
+        let Element::Spring { axes_a, axes_b, .. } = &entry.element else {
+            continue;
+        };
+        let (na, nb) = (axes_a.len(), axes_b.len());
+        let start = solution.offsets[k];
+        let w_start = start + 1 + na + nb;
+        let columns = &basis.elements[solution.elements[k]];
+        let stiffness = solution.affine(start);
+        let mut required: Option<Rational> = None;
+        for r in 0..basis.monomials.len() {
+            let weights: Vec<Rational> = (0..na * nb)
+                .map(|ij| Rational::from_integer(columns[1 + na + nb + ij][r].clone()))
+                .collect();
+            if weights.iter().all(Zero::is_zero) {
+                continue;
+            }
+            let mut residual = Quadratic::zero(n);
+            for i in 0..na {
+                for j in 0..nb {
+                    let a = &weights[i * nb + j];
+                    residual.add_product(a, &stiffness, &solution.affine(w_start + i * nb + j));
+                    residual.add_product(
+                        &-a.clone(),
+                        &solution.affine(start + 1 + i),
+                        &solution.affine(start + 1 + na + j),
+                    );
+                }
+            }
+            match demand(&residual, &stiffness) {
+                // A row this test cannot read adds conditions, but takes none away.
+                Demand::Unknown | Demand::Nothing => {}
+                Demand::Impossible(c0) => {
+                    return Some(format!(
+                        "{}: no spring has the anchors balance requires (K·W − α·βᵀ = {} for \
+                         every K)",
+                        entry.label,
+                        exact_text(&c0)
+                    ));
+                }
+                Demand::Stiffness(value) => {
+                    if let Some(previous) = &required
+                        && *previous != value
+                    {
+                        return Some(format!(
+                            "{}: balance would need the stiffness to be both {} and {} N/m",
+                            entry.label,
+                            exact_text(previous),
+                            exact_text(&value)
+                        ));
+                    }
+                    required = Some(value);
+                }
+            }
+        }
+        let Some(value) = required else { continue };
+        if !value.is_positive() {
+            return Some(format!(
+                "{}: a rank-one K·a·bᵀ needs K = {} N/m, which is no spring",
+                entry.label,
+                exact_text(&value)
+            ));
+        }
+        // The forced stiffness must also be reachable with every head positive.
+        if let Ok(range) = positivity::range(&heads, &stiffness) {
+            let below = range
+                .low
+                .as_ref()
+                .is_some_and(|l| value < l.value || (value == l.value && !l.closed));
+            let above = range
+                .high
+                .as_ref()
+                .is_some_and(|h| value > h.value || (value == h.value && !h.closed));
+            if below || above {
+                return Some(format!(
+                    "{}: a rank-one K·a·bᵀ needs K = {} N/m, outside what positive masses and \
+                     stiffnesses allow",
+                    entry.label,
+                    exact_text(&value)
+                ));
+            }
+        }
+    }
+    None
+}
