@@ -1,10 +1,10 @@
-//! Criterion benches of the balance decision on the palletizer: the linear stage alone (every
-//! variant's consistency, particular solution and free directions) and the whole search
-//! (linear stage + realization + verification), at Dmax = 2 and 3.
+//! Criterion benches of the balance decision on the palletizer: the exact linear stage alone
+//! (every variant's exact elimination) and the whole search (exact decision, proofs,
+//! realization and verification), at Dmax = 2 and 3.
 
 use std::path::PathBuf;
 
-use counterpoise_balance::linear::{LiftedBasis, solve};
+use counterpoise_balance::exact::ExactBasis;
 use counterpoise_balance::{
     Catalogue, SearchOptions, catalogue_options, mechanism_energy, realization_hints, search,
 };
@@ -23,31 +23,32 @@ fn benches(c: &mut Criterion) {
     let mut group = c.benchmark_group("palletizer");
     group.sample_size(10);
     for dmax in [2usize, 3] {
-        group.bench_function(format!("linear_stage_dmax{dmax}"), |b| {
+        group.bench_function(format!("exact_stage_dmax{dmax}"), |b| {
             b.iter(|| {
-                let basis = LiftedBasis::build(&energy, &catalogue);
+                let mechanism = energy.exact.as_ref().expect("the palletizer is exact");
+                let basis = ExactBasis::build(mechanism, &catalogue);
                 let sets: Vec<Vec<usize>> =
                     counterpoise_balance::enumerate::variants(catalogue.len(), dmax).collect();
                 sets.par_iter()
-                    .filter(|s| solve(&basis, s).consistent)
+                    .filter(|s| basis.solve(s).consistent())
                     .count()
             })
         });
+        group.bench_function(format!("whole_search_dmax{dmax}"), |b| {
+            b.iter(|| {
+                search(
+                    &energy,
+                    catalogue.clone(),
+                    SearchOptions {
+                        dmax,
+                        hints: realization_hints(&model),
+                    },
+                )
+                .variants
+                .len()
+            })
+        });
     }
-    group.bench_function("whole_search_dmax2", |b| {
-        b.iter(|| {
-            search(
-                &energy,
-                catalogue.clone(),
-                SearchOptions {
-                    dmax: 2,
-                    hints: realization_hints(&model),
-                },
-            )
-            .variants
-            .len()
-        })
-    });
     group.finish();
 }
 

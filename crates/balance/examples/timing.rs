@@ -3,7 +3,9 @@
 
 use std::time::Instant;
 
-use counterpoise_balance::linear::{LiftedBasis, solve};
+use counterpoise_balance::exact::ExactBasis;
+use counterpoise_balance::linear::LiftedBasis;
+use counterpoise_balance::search::Bases;
 use counterpoise_balance::{
     Catalogue, VerificationSet, catalogue_options, decide, mechanism_energy, realization_hints,
 };
@@ -17,24 +19,35 @@ fn main() {
     let energy = mechanism_energy(&model);
     let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
     let basis = LiftedBasis::build(&energy, &catalogue);
+    let exact = energy
+        .exact
+        .as_ref()
+        .ok()
+        .map(|m| ExactBasis::build(m, &catalogue));
     let checks = VerificationSet::new(&energy);
     println!("setup {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
     let sets: Vec<Vec<usize>> =
         counterpoise_balance::enumerate::variants(catalogue.len(), dmax).collect();
-    let t = Instant::now();
-    let consistent = sets.iter().filter(|s| solve(&basis, s).consistent).count();
-    println!(
-        "linear stage {} variants ({consistent} consistent): {:.1} ms",
-        sets.len(),
-        t.elapsed().as_secs_f64() * 1e3
-    );
+    if let Some(exact) = &exact {
+        let t = Instant::now();
+        let consistent = sets.iter().filter(|s| exact.solve(s).consistent()).count();
+        println!(
+            "exact linear stage {} variants ({consistent} consistent): {:.1} ms",
+            sets.len(),
+            t.elapsed().as_secs_f64() * 1e3
+        );
+    }
+    let bases = Bases {
+        numeric: &basis,
+        exact: exact.as_ref(),
+    };
     let mut by_status = std::collections::BTreeMap::new();
     for s in &sets {
         let t = Instant::now();
         let r = decide(
             &energy,
             &catalogue,
-            &basis,
+            bases,
             &checks,
             s,
             realization_hints(&model),

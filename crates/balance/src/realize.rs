@@ -265,7 +265,7 @@ const IDENTITY_SAMPLES: usize = 8;
 /// probability one — and that affine function of `K` has no root with `K > 0`, no spring exists.
 /// This is the palletizer's lone `K42`: balance fixes `a = (1/4, 0)` and `K·b`, so
 /// `K·(a×b)` is a fixed multiple of `K` that differs from the required value for every `K > 0`.
-fn rank_one_contradiction(
+pub fn rank_one_contradiction(
     solution: &LinearSolution,
     entries: &[(usize, &CatalogueEntry)],
 ) -> Option<String> {

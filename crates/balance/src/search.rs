@@ -305,17 +305,34 @@ fn decide_exact(
     let positive: Vec<usize> = (0..entries.len()).map(|k| solution.offsets[k]).collect();
     result.free_directions = free_directions(&linear, &names, &positive);
 
-    if let Some(reason) = exact_proof(exact, &solution, entries) {
+    if let Some(reason) = exact_sign_proof(&solution, entries) {
+        result.status = Status::Unrealizable;
+        result.reason = Some(reason);
+        return;
+    }
+    // The exact rank-one test is costly; a floating-point screen says when it is worth running
+    // (the screen decides nothing: only the exact test can prove).
+    let refs: Vec<&CatalogueEntry> = entries.iter().map(|(_, e)| *e).collect();
+    let screened = crate::realize::rank_one_contradiction(&linear, entries).is_some();
+    if screened && let Some(reason) = rank_one::contradiction(exact, &solution, &refs) {
         result.status = Status::Unrealizable;
         result.reason = Some(reason);
         return;
     }
     result.ranges = admissible_ranges(&solution, entries, &names, &units);
+    // A verified witness settles it; the remaining proofs run only when none is found.
+    let witness = match find_witness(&linear, &numeric.unbalanced, entries, hints) {
+        Ok(witness) => return accept_witness(checks, witness, result),
+        Err(reason) => reason,
+    };
+    if !screened && let Some(reason) = rank_one::contradiction(exact, &solution, &refs) {
+        result.status = Status::Unrealizable;
+        result.reason = Some(reason);
+        return;
+    }
     // Springs whose anchor balance fixes: W = a₀ βᵀ (or α b₀ᵀ) is then linear; impose it.
     let (anchors, extra) = fixed_anchor_equations(&solution, entries);
-    let linear = if extra.is_empty() {
-        linear
-    } else {
+    if !extra.is_empty() {
         let restricted = exact.solve_with(&set, &extra);
         let context = format!("with {} fixed by balance, ", anchors.join(" and "));
         if !restricted.consistent() {
@@ -325,26 +342,25 @@ fn decide_exact(
             ));
             return;
         }
-        if let Some(reason) = exact_proof(exact, &restricted, entries) {
+        let proof = exact_sign_proof(&restricted, entries)
+            .or_else(|| rank_one::contradiction(exact, &restricted, &refs));
+        if let Some(reason) = proof {
             result.status = Status::Unrealizable;
             result.reason = Some(format!("{context}{reason}"));
             return;
         }
-        linear_from_exact(numeric, &restricted)
-    };
-    match find_witness(&linear, &numeric.unbalanced, entries, hints) {
-        Ok(witness) => accept_witness(checks, witness, result),
-        Err(reason) => {
-            result.status = Status::Undecided;
-            result.reason = Some(reason);
+        let linear = linear_from_exact(numeric, &restricted);
+        if let Ok(witness) = find_witness(&linear, &numeric.unbalanced, entries, hints) {
+            return accept_witness(checks, witness, result);
         }
     }
+    result.status = Status::Undecided;
+    result.reason = Some(witness);
 }
 
-/// Proofs of unrealizability in exact arithmetic: a mass or stiffness fixed at zero or below,
-/// no positive point of the family (Farkas certificate), an impossible rank-one spring.
-fn exact_proof(
-    exact: &ExactBasis,
+/// Proofs of unrealizability from signs, in exact arithmetic: a mass or stiffness fixed at zero
+/// or below, or no positive point of the family (Farkas certificate).
+fn exact_sign_proof(
     solution: &ExactSolution,
     entries: &[(usize, &CatalogueEntry)],
 ) -> Option<String> {
@@ -389,8 +405,7 @@ fn exact_proof(
             crate::exact::exact_text(&certificate.value)
         ));
     }
-    let refs: Vec<&CatalogueEntry> = entries.iter().map(|(_, e)| *e).collect();
-    rank_one::contradiction(exact, solution, &refs)
+    None
 }
 
 /// For every spring whose anchor `a` (or `b`) balance fixes — `K·a = a₀·K` on the whole family —
