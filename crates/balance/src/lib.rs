@@ -30,5 +30,7 @@ pub use element::{Attachment, Catalogue, CatalogueEntry, CatalogueOptions, Eleme
 pub use energy::{BodyFrame, MechanismEnergy};
 pub use model_input::{catalogue_options, mechanism_energy, realization_hints};
 pub use realize::{CounterweightParams, RealizationHints, SpringParams, Witness};
-pub use search::{Class, SearchOptions, SearchReport, Status, VariantResult, decide, search};
+pub use search::{
+    Class, Decision, SearchOptions, SearchReport, Status, VariantResult, decide, search,
+};
 pub use verify::{VERIFY_SAMPLES, VERIFY_TOL, Verification, VerificationSet};

@@ -4,8 +4,9 @@ use std::path::PathBuf;
 
 use counterpoise_balance::verify::element_energy;
 use counterpoise_balance::{
-    Attachment, Catalogue, CounterweightParams, MechanismEnergy, SearchOptions, SearchReport,
-    SpringParams, Status, Witness, catalogue_options, mechanism_energy, realization_hints, search,
+    Attachment, Catalogue, CounterweightParams, Decision, MechanismEnergy, SearchOptions,
+    SearchReport, SpringParams, Status, Witness, catalogue_options, mechanism_energy,
+    realization_hints, search,
 };
 use counterpoise_model::sampling::SplitMix64;
 use counterpoise_model::{Case, Model};
@@ -148,8 +149,19 @@ fn a_lone_upper_arm_to_slider_spring_is_proven_unrealizable() {
     let report = run(&model, 1);
     let k42 = find(&report, &["K42"]);
     assert_eq!(k42.status, Status::Unrealizable, "{k42:?}");
+    assert_eq!(k42.decision, Decision::Exact);
     let reason = k42.reason.as_deref().unwrap();
-    assert!(reason.contains("-2.8305e3·K"), "{reason}");
+    // The certificate quotes the residual exactly: `K·W − α·βᵀ = -N/D (…)·K`, zero only at K = 0.
+    assert!(reason.contains("zero only at K = 0 N/m"), "{reason}");
+    let fraction = reason
+        .split("K·W − α·βᵀ = ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .unwrap_or_else(|| panic!("no residual in {reason}"));
+    let (num, den) = fraction.split_once('/').expect("an exact fraction");
+    let value = num.parse::<f64>().unwrap() / den.parse::<f64>().unwrap();
+    // palletizer.md: V_UB = −672.843·sin θ2 + 2830.492·sin θ3 (three decimals).
+    assert!((value + 2830.492).abs() < 5e-4, "{value}");
 }
 
 fn polar(r: f64, angle: f64) -> [f64; 3] {

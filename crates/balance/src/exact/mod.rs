@@ -41,6 +41,8 @@ pub struct ExactBasis {
     pub unbalanced: Vec<BigInt>,
     /// Per catalogue entry, per lifted variable: the row-scaled column.
     pub elements: Vec<Vec<Vec<BigInt>>>,
+    /// The positive factor each row was scaled by (physical coefficient × factor = integer).
+    pub row_factors: Vec<Rational>,
 }
 
 /// The exact energy polynomials of one catalogue entry, per lifted variable.
@@ -132,6 +134,7 @@ impl ExactBasis {
                 .iter()
                 .map(|entry| entry.iter().map(|c| scale(c)).collect())
                 .collect(),
+            row_factors: factors,
         }
     }
 

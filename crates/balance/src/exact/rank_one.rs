@@ -67,10 +67,10 @@ enum Demand {
     Unknown,
     /// Zero everywhere: no condition.
     Nothing,
-    /// Never zero.
+    /// `c₀ + c₁·K` with `c₁ = 0 ≠ c₀`: never zero.
     Impossible(Rational),
-    /// Zero exactly at `K = value`.
-    Stiffness(Rational),
+    /// `c₀ + c₁·K` with `c₁ ≠ 0`: zero exactly at `K = −c₀/c₁`.
+    Stiffness { c0: Rational, c1: Rational },
 }
 
 fn demand(residual: &Quadratic, stiffness: &Affine) -> Demand {
@@ -93,7 +93,7 @@ fn demand(residual: &Quadratic, stiffness: &Affine) -> Demand {
     match (c0.is_zero(), c1.is_zero()) {
         (true, true) => Demand::Nothing,
         (false, true) => Demand::Impossible(c0),
-        (_, false) => Demand::Stiffness(-c0 / c1),
+        (_, false) => Demand::Stiffness { c0, c1 },
     }
 }
 
@@ -115,6 +115,7 @@ pub fn contradiction(
         let columns = &basis.elements[solution.elements[k]];
         let stiffness = solution.affine(start);
         let mut required: Option<Rational> = None;
+        let mut form = String::new();
         for r in 0..basis.monomials.len() {
             let weights: Vec<Rational> = (0..na * nb)
                 .map(|ij| Rational::from_integer(columns[1 + na + nb + ij][r].clone()))
@@ -142,10 +143,18 @@ pub fn contradiction(
                         "{}: no spring has the anchors balance requires (K·W − α·βᵀ = {} for \
                          every K)",
                         entry.label,
-                        exact_text(&c0)
+                        exact_text(&(c0 / &basis.row_factors[r]))
                     ));
                 }
-                Demand::Stiffness(value) => {
+                Demand::Stiffness { c0, c1 } => {
+                    let value = -&c0 / &c1;
+                    // In physical units (J per unit), undoing the row's integer scaling.
+                    let (c0, c1) = (c0 / &basis.row_factors[r], c1 / &basis.row_factors[r]);
+                    form = if c0.is_zero() {
+                        format!("K·W − α·βᵀ = {}·K", exact_text(&c1))
+                    } else {
+                        format!("K·W − α·βᵀ = {} + {}·K", exact_text(&c0), exact_text(&c1))
+                    };
                     if let Some(previous) = &required
                         && *previous != value
                     {
@@ -163,7 +172,8 @@ pub fn contradiction(
         let Some(value) = required else { continue };
         if !value.is_positive() {
             return Some(format!(
-                "{}: a rank-one K·a·bᵀ needs K = {} N/m, which is no spring",
+                "{}: no spring has the anchors balance requires ({form} on every solution, zero \
+                 only at K = {} N/m)",
                 entry.label,
                 exact_text(&value)
             ));
@@ -180,8 +190,8 @@ pub fn contradiction(
                 .is_some_and(|h| value > h.value || (value == h.value && !h.closed));
             if below || above {
                 return Some(format!(
-                    "{}: a rank-one K·a·bᵀ needs K = {} N/m, outside what positive masses and \
-                     stiffnesses allow",
+                    "{}: no spring has the anchors balance requires ({form} on every solution, \
+                     zero only at K = {} N/m, outside what positive masses and stiffnesses allow)",
                     entry.label,
                     exact_text(&value)
                 ));
