@@ -3,9 +3,7 @@
 
 use std::time::Instant;
 
-use counterpoise_balance::exact::ExactBasis;
 use counterpoise_balance::linear::LiftedBasis;
-use counterpoise_balance::search::Bases;
 use counterpoise_balance::{
     Catalogue, VerificationSet, catalogue_options, decide, mechanism_energy, realization_hints,
 };
@@ -19,16 +17,11 @@ fn main() {
     let energy = mechanism_energy(&model);
     let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
     let basis = LiftedBasis::build(&energy, &catalogue);
-    let exact = energy
-        .exact
-        .as_ref()
-        .ok()
-        .map(|m| ExactBasis::build(m, &catalogue));
     let checks = VerificationSet::new(&energy);
     println!("setup {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
     let sets: Vec<Vec<usize>> =
         counterpoise_balance::enumerate::variants(catalogue.len(), dmax).collect();
-    if let Some(exact) = &exact {
+    if let Some(exact) = &basis.exact {
         let t = Instant::now();
         let consistent = sets.iter().filter(|s| exact.solve(s).consistent()).count();
         println!(
@@ -37,17 +30,13 @@ fn main() {
             t.elapsed().as_secs_f64() * 1e3
         );
     }
-    let bases = Bases {
-        numeric: &basis,
-        exact: exact.as_ref(),
-    };
     let mut by_status = std::collections::BTreeMap::new();
     for s in &sets {
         let t = Instant::now();
         let r = decide(
             &energy,
             &catalogue,
-            bases,
+            &basis,
             &checks,
             s,
             realization_hints(&model),

@@ -4,10 +4,14 @@
 //! trigonometric-polynomial form vanishes. Rows of `A` are the non-constant basis monomials, its
 //! columns the lifted variables of the chosen elements, `b` the unbalanced coefficients.
 //!
-//! Rank decisions use the SVD of `A` with unit-norm columns (so that kilograms and newtons per
-//! metre compare fairly): singular values below [`RANK_TOL`]·σ_max count as zero, and the system
-//! is consistent when the least-squares residual is below [`CONSISTENCY_TOL`]·‖b‖. An
-//! inconsistent system is a proof (to that tolerance) that no parameters balance the variant.
+//! When the case is exact, [`solve`] returns the exact family ([`crate::exact`]) rounded to
+//! doubles: rank, consistency and free directions are then facts. Otherwise it decides in floating
+//! point with faer's SVD of `A` with unit-norm columns (so that kilograms and newtons per metre
+//! compare fairly), with an explicit ambiguous zone: a singular value above [`RANK_TOL`]·σ_max is
+//! non-zero, one below [`ZERO_TOL`]·σ_max is zero, and one in between makes the variant
+//! *ambiguous*; likewise a relative residual below [`CONSISTENCY_TOL`] is consistent, one above
+//! [`INCONSISTENCY_TOL`] is not, and one in between is ambiguous. An ambiguous variant is reported
+//! undecided, never rounded into a verdict.
 
 use std::collections::BTreeMap;
 
@@ -16,11 +20,16 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::element::Catalogue;
 use crate::energy::MechanismEnergy;
+use crate::exact::{ExactBasis, ExactSolution};
 
-/// Relative singular-value threshold for rank decisions.
+/// Relative singular value above which a direction certainly counts (numeric path).
 pub const RANK_TOL: f64 = 1e-9;
-/// Relative residual below which `A x = −b` counts as solvable.
+/// Relative singular value below which a direction certainly does not count (numeric path).
+pub const ZERO_TOL: f64 = 1e-12;
+/// Relative residual below which `A x = −b` certainly counts as solvable (numeric path).
 pub const CONSISTENCY_TOL: f64 = 1e-9;
+/// Relative residual above which `A x = −b` certainly has no solution (numeric path).
+pub const INCONSISTENCY_TOL: f64 = 1e-6;
 /// Scaled magnitude below which a free direction is taken not to move a variable.
 pub const FIXED_TOL: f64 = 1e-7;
 
@@ -34,6 +43,8 @@ pub struct LiftedBasis {
     pub unbalanced: DVector<f64>,
     /// Per catalogue entry: rows × lifted variables.
     pub elements: Vec<DMatrix<f64>>,
+    /// The exact basis, when the case's numbers are rational.
+    pub exact: Option<ExactBasis>,
 }
 
 impl LiftedBasis {
@@ -74,6 +85,11 @@ impl LiftedBasis {
             monomials: index.into_keys().collect(),
             unbalanced,
             elements,
+            exact: energy
+                .exact
+                .as_ref()
+                .ok()
+                .map(|mechanism| ExactBasis::build(mechanism, catalogue)),
         }
     }
 
@@ -113,47 +129,105 @@ pub struct LinearSolution {
     pub rank: usize,
     /// Column norms used for scaling (1 for zero columns).
     pub column_scale: DVector<f64>,
+    /// Numeric path only: why rank or consistency is neither clearly one thing nor the other.
+    pub ambiguity: Option<String>,
 }
 
-/// Solves one variant's balance system.
+/// Solves one variant's balance system: exactly when the basis has an exact part, in floating
+/// point otherwise.
 pub fn solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
-    let (matrix, offsets) = basis.system(elements);
+    match &basis.exact {
+        Some(exact) => {
+            let solution = exact.solve(elements);
+            if solution.consistent() {
+                from_exact(basis, &solution)
+            } else {
+                // The least-squares residual is only informative; consistency is the exact fact.
+                let mut numeric = numeric_solve(basis, elements);
+                numeric.consistent = false;
+                numeric.ambiguity = None;
+                numeric.rank = solution.rank();
+                numeric
+            }
+        }
+        None => numeric_solve(basis, elements),
+    }
+}
+
+/// An exact consistent family rounded to doubles (the witness search and the optimiser work in
+/// floating point).
+pub fn from_exact(basis: &LiftedBasis, solution: &ExactSolution) -> LinearSolution {
+    use counterpoise_symbolic::rational_to_f64;
+    let (matrix, offsets) = basis.system(&solution.elements);
+    let cols = matrix.ncols();
+    let column_scale = column_norms(&matrix);
+    let particular = DVector::from_iterator(cols, solution.particular.iter().map(rational_to_f64));
+    let nullspace = DMatrix::from_fn(cols, solution.nullspace.len(), |j, f| {
+        rational_to_f64(&solution.nullspace[f][j])
+    });
     let b = &basis.unbalanced;
-    let (rows, cols) = matrix.shape();
-    let column_scale = DVector::from_iterator(
-        cols,
+    let residual = (&matrix * &particular + b).norm() / b.norm().max(f64::MIN_POSITIVE);
+    LinearSolution {
+        matrix,
+        offsets,
+        consistent: true,
+        residual,
+        particular,
+        nullspace,
+        rank: solution.rank(),
+        column_scale,
+        ambiguity: None,
+    }
+}
+
+fn column_norms(matrix: &DMatrix<f64>) -> DVector<f64> {
+    DVector::from_iterator(
+        matrix.ncols(),
         matrix.column_iter().map(|c| {
             let n = c.norm();
             if n > 0.0 { n } else { 1.0 }
         }),
-    );
-    // Scaled and padded so that the thin SVD still yields the whole right singular basis.
-    let mut scaled = DMatrix::zeros(rows.max(cols), cols);
-    for j in 0..cols {
-        let column = matrix.column(j) / column_scale[j];
-        scaled.view_mut((0, j), (rows, 1)).copy_from(&column);
-    }
-    let mut rhs = DVector::zeros(rows.max(cols));
-    rhs.rows_mut(0, rows).copy_from(&(-b));
+    )
+}
 
-    let svd = scaled.svd(true, true);
-    let u = svd.u.expect("SVD computed with U");
-    let v_t = svd.v_t.expect("SVD computed with Vᵀ");
-    let sigma = &svd.singular_values;
-    let sigma_max = sigma.iter().fold(0.0f64, |a, &s| a.max(s));
-    let cutoff = RANK_TOL * sigma_max;
-
+/// Solves one variant's balance system in floating point (faer's SVD, with the ambiguous zone
+/// of the module documentation).
+pub fn numeric_solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
+    let (matrix, offsets) = basis.system(elements);
+    let b = &basis.unbalanced;
+    let (rows, cols) = matrix.shape();
+    let column_scale = column_norms(&matrix);
+    let scaled = faer::Mat::from_fn(rows, cols, |i, j| matrix[(i, j)] / column_scale[j]);
+    let mut ambiguity = None;
     let mut y = DVector::zeros(cols);
     let mut null_columns = Vec::new();
     let mut rank = 0;
-    for k in 0..sigma.len() {
-        let v_k = v_t.row(k).transpose();
-        if sigma[k] > cutoff && sigma_max > 0.0 {
-            rank += 1;
-            let coefficient = u.column(k).dot(&rhs) / sigma[k];
-            y += v_k * coefficient;
-        } else {
-            null_columns.push(v_k);
+    match scaled.svd() {
+        Ok(svd) => {
+            let (u, v) = (svd.U(), svd.V());
+            let sigma: Vec<f64> = svd.S().column_vector().iter().copied().collect();
+            let sigma_max = sigma.iter().fold(0.0f64, |a, &s| a.max(s));
+            for k in 0..cols {
+                let s = sigma.get(k).copied().unwrap_or(0.0);
+                let v_k = DVector::from_fn(cols, |j, _| v[(j, k)]);
+                if sigma_max > 0.0 && s > RANK_TOL * sigma_max {
+                    rank += 1;
+                    let coefficient = (0..rows).map(|i| -u[(i, k)] * b[i]).sum::<f64>() / s;
+                    y += v_k * coefficient;
+                } else {
+                    if sigma_max > 0.0 && s > ZERO_TOL * sigma_max && ambiguity.is_none() {
+                        ambiguity = Some(format!(
+                            "a singular value of {:.1e} relative to the largest is neither clearly \
+                             zero (< {ZERO_TOL:.0e}) nor clearly not (> {RANK_TOL:.0e})",
+                            s / sigma_max
+                        ));
+                    }
+                    null_columns.push(v_k);
+                }
+            }
+        }
+        Err(e) => {
+            ambiguity = Some(format!("the SVD did not converge ({e:?})"));
         }
     }
     let particular = y.component_mul(&column_scale.map(|s| 1.0 / s));
@@ -174,6 +248,12 @@ pub fn solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
     } else {
         residual_vector.norm()
     };
+    if ambiguity.is_none() && residual > CONSISTENCY_TOL && residual < INCONSISTENCY_TOL {
+        ambiguity = Some(format!(
+            "the relative residual {residual:.1e} is neither clearly zero (< {CONSISTENCY_TOL:.0e}) \
+             nor clearly not (> {INCONSISTENCY_TOL:.0e})"
+        ));
+    }
     LinearSolution {
         consistent: residual <= CONSISTENCY_TOL,
         matrix,
@@ -183,6 +263,7 @@ pub fn solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
         nullspace,
         rank,
         column_scale,
+        ambiguity,
     }
 }
 

@@ -9,7 +9,7 @@ use crate::element::{Attachment, Catalogue, CatalogueEntry, Element};
 use crate::energy::MechanismEnergy;
 use crate::enumerate::variants;
 use crate::exact::{ExactBasis, ExactSolution, positivity, rank_one};
-use crate::linear::{LiftedBasis, LinearSolution, solve};
+use crate::linear::{LiftedBasis, solve};
 use crate::realize::{Realization, RealizationHints, Witness, find_witness, realize};
 use crate::relations::{
     AdmissibleRange, FreeDirection, admissible_ranges, balance_relations, exact_relations,
@@ -171,20 +171,11 @@ pub fn search(
     options: SearchOptions,
 ) -> SearchReport {
     let basis = LiftedBasis::build(energy, &catalogue);
-    let exact = energy
-        .exact
-        .as_ref()
-        .ok()
-        .map(|mechanism| ExactBasis::build(mechanism, &catalogue));
     let checks = VerificationSet::new(energy);
     let sets: Vec<Vec<usize>> = variants(catalogue.len(), options.dmax).collect();
-    let bases = Bases {
-        numeric: &basis,
-        exact: exact.as_ref(),
-    };
     let variants = sets
         .par_iter()
-        .map(|set| decide(energy, &catalogue, bases, &checks, set, options.hints))
+        .map(|set| decide(energy, &catalogue, &basis, &checks, set, options.hints))
         .collect();
     SearchReport {
         catalogue,
@@ -192,29 +183,21 @@ pub fn search(
     }
 }
 
-/// The lifted bases a decision reads: always the numeric one, and the exact one when the case's
-/// numbers are rational.
-#[derive(Clone, Copy)]
-pub struct Bases<'a> {
-    pub numeric: &'a LiftedBasis,
-    pub exact: Option<&'a ExactBasis>,
-}
-
 /// Decides one variant: linear consistency, degeneracy, realizability, verification — exactly
 /// when the case allows it, numerically otherwise.
 pub fn decide(
     energy: &MechanismEnergy,
     catalogue: &Catalogue,
-    bases: Bases,
+    basis: &LiftedBasis,
     checks: &VerificationSet,
     set: &[usize],
     hints: RealizationHints,
 ) -> VariantResult {
     let entries: Vec<_> = set.iter().map(|&e| (e, &catalogue.entries[e])).collect();
     let mut result = new_result(energy, &entries);
-    match bases.exact {
-        Some(exact) => decide_exact(bases.numeric, exact, checks, &entries, hints, &mut result),
-        None => decide_numeric(bases.numeric, checks, &entries, hints, &mut result),
+    match &basis.exact {
+        Some(exact) => decide_exact(basis, exact, checks, &entries, hints, &mut result),
+        None => decide_numeric(basis, checks, &entries, hints, &mut result),
     }
     result
 }
@@ -278,7 +261,7 @@ fn decide_exact(
     let solution = exact.solve(&set);
     result.rank = solution.rank();
     if !solution.consistent() {
-        result.linear_residual = solve(numeric, &set).residual;
+        result.linear_residual = crate::linear::numeric_solve(numeric, &set).residual;
         result.reason = Some(format!(
             "the balance equations have no solution (exact: rank {} of the element columns, \
              {} with the unbalanced energy)",
@@ -301,7 +284,7 @@ fn decide_exact(
     }
     let (names, units) = names_and_units(entries);
     result.relations = exact_relations(&solution, &names, &units);
-    let linear = linear_from_exact(numeric, &solution);
+    let linear = crate::linear::from_exact(numeric, &solution);
     let positive: Vec<usize> = (0..entries.len()).map(|k| solution.offsets[k]).collect();
     result.free_directions = free_directions(&linear, &names, &positive);
 
@@ -349,7 +332,7 @@ fn decide_exact(
             result.reason = Some(format!("{context}{reason}"));
             return;
         }
-        let linear = linear_from_exact(numeric, &restricted);
+        let linear = crate::linear::from_exact(numeric, &restricted);
         if let Ok(witness) = find_witness(&linear, &numeric.unbalanced, entries, hints) {
             return accept_witness(checks, witness, result);
         }
@@ -457,37 +440,6 @@ fn fixed_anchor_equations(
     (anchors, rows)
 }
 
-/// The exact family in floating point, for the witness search and the free-direction display.
-fn linear_from_exact(numeric: &LiftedBasis, solution: &ExactSolution) -> LinearSolution {
-    use counterpoise_symbolic::rational_to_f64;
-    use nalgebra::{DMatrix, DVector};
-    let (matrix, offsets) = numeric.system(&solution.elements);
-    let cols = matrix.ncols();
-    let column_scale = DVector::from_iterator(
-        cols,
-        matrix.column_iter().map(|c| {
-            let n = c.norm();
-            if n > 0.0 { n } else { 1.0 }
-        }),
-    );
-    let particular = DVector::from_iterator(cols, solution.particular.iter().map(rational_to_f64));
-    let nullspace = DMatrix::from_fn(cols, solution.nullspace.len(), |j, f| {
-        rational_to_f64(&solution.nullspace[f][j])
-    });
-    let b = &numeric.unbalanced;
-    let residual = (&matrix * &particular + b).norm() / b.norm().max(f64::MIN_POSITIVE);
-    LinearSolution {
-        matrix,
-        offsets,
-        consistent: true,
-        residual,
-        particular,
-        nullspace,
-        rank: solution.rank(),
-        column_scale,
-    }
-}
-
 /// Verifies a witness by sampling the physical energy; balanced (or degenerate, when some
 /// element can only idle) if it passes, undecided if not.
 fn accept_witness(checks: &VerificationSet, witness: Witness, result: &mut VariantResult) {
@@ -533,6 +485,11 @@ fn decide_numeric(
     result.rank = solution.rank;
     result.nullity = solution.nullspace.ncols();
     result.linear_residual = solution.residual;
+    if let Some(ambiguity) = &solution.ambiguity {
+        result.status = Status::Undecided;
+        result.reason = Some(format!("numerically ambiguous: {ambiguity}"));
+        return;
+    }
     if !solution.consistent {
         result.reason = Some(format!(
             "the balance equations have no solution (relative residual {:.2e})",
