@@ -97,8 +97,6 @@ pub enum Realization {
     Found(Witness),
     /// Proven impossible, with the reason.
     Impossible(String),
-    /// The variant really is a smaller one: an element must vanish or is not what it claims.
-    Degenerate(String),
     /// The local search gave up; the reason says how far it got.
     GaveUp(String),
 }
@@ -149,7 +147,7 @@ pub fn numeric_proofs(
             match entry.element {
                 Element::Counterweight { .. } if zero => {
                     return Some(Realization::Impossible(format!(
-                        "{}: mass must be zero while m·r is not: no counterweight does that",
+                        "{}: balance forces its mass to zero",
                         entry.label
                     )));
                 }
@@ -160,9 +158,8 @@ pub fn numeric_proofs(
                     )));
                 }
                 Element::Spring { .. } if zero => {
-                    return Some(Realization::Degenerate(format!(
-                        "{}: stiffness must be zero while K·a or K·b is not: the element would act \
-                         as a constant force, not a spring",
+                    return Some(Realization::Impossible(format!(
+                        "{}: balance forces its stiffness to zero",
                         entry.label
                     )));
                 }

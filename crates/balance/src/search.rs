@@ -517,10 +517,6 @@ fn decide_numeric(
             result.status = Status::Unrealizable;
             result.reason = Some(reason);
         }
-        Realization::Degenerate(reason) => {
-            result.status = Status::Degenerate;
-            result.reason = Some(reason);
-        }
         Realization::GaveUp(reason) => {
             result.status = Status::Undecided;
             result.reason = Some(reason);

@@ -1,0 +1,361 @@
+//! The exact balance decision on the palletizer: pinned verdict counts that match an independent
+//! exact computation, certificates for the cases floating point got wrong, and the invariants an
+//! exact decision must keep (monotone consistency, agreement with confident floating point,
+//! verdicts unmoved by a one-ulp change of an input).
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+use counterpoise_balance::linear::{LiftedBasis, numeric_solve};
+use counterpoise_balance::{
+    Catalogue, Decision, SearchOptions, SearchReport, Status, VariantResult, Witness,
+    catalogue_options, mechanism_energy, realization_hints, search,
+};
+use counterpoise_model::sampling::SplitMix64;
+use counterpoise_model::{Case, Kinematics, Model};
+use nalgebra::{DVector, Vector3};
+
+fn palletizer_json() -> serde_json::Value {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/palletizer.json");
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn model_of(json: &serde_json::Value) -> Model {
+    Case::from_json_str(&json.to_string()).expect("valid case")
+}
+
+fn run(model: &Model, dmax: usize) -> SearchReport {
+    let energy = mechanism_energy(model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
+    search(
+        &energy,
+        catalogue,
+        SearchOptions {
+            dmax,
+            hints: realization_hints(model),
+        },
+    )
+}
+
+fn labels(v: &VariantResult) -> Vec<String> {
+    let mut l: Vec<String> = v.elements.iter().map(|e| e.label.clone()).collect();
+    l.sort();
+    l
+}
+
+fn find<'a>(report: &'a SearchReport, wanted: &[&str]) -> &'a VariantResult {
+    let mut wanted: Vec<String> = wanted.iter().map(|s| s.to_string()).collect();
+    wanted.sort();
+    report
+        .variants
+        .iter()
+        .find(|v| labels(v) == wanted)
+        .unwrap_or_else(|| panic!("{wanted:?} not enumerated"))
+}
+
+fn counts(report: &SearchReport) -> [usize; 5] {
+    Status::ALL.map(|s| report.count(s))
+}
+
+fn realizable(v: &VariantResult) -> bool {
+    matches!(v.status, Status::Balanced | Status::Degenerate)
+}
+
+/// An independent exact computation (rational arithmetic, positivity of masses and stiffnesses,
+/// idle springs counted as realizable) finds 103 realizable sets at Dmax 2 and 1325 at Dmax 3.
+#[test]
+fn palletizer_verdicts_match_the_independent_exact_counts() {
+    let model = model_of(&palletizer_json());
+    for (dmax, expected_realizable, pinned) in [
+        (2, 103, [97, 6, 146, 157, 0]),
+        (3, 1325, [1169, 156, 1642, 715, 0]),
+    ] {
+        let report = run(&model, dmax);
+        assert!(
+            report
+                .variants
+                .iter()
+                .all(|v| v.decision == Decision::Exact)
+        );
+        let realizable_count = report.variants.iter().filter(|v| realizable(v)).count();
+        assert_eq!(realizable_count, expected_realizable, "Dmax {dmax}");
+        // Balanced, degenerate, unrealizable, infeasible, undecided.
+        assert_eq!(counts(&report), pinned, "Dmax {dmax}");
+        // Every realizable verdict carries a verified witness above the floor; every other
+        // verdict carries its reason.
+        let hints = realization_hints(&model);
+        for v in &report.variants {
+            if realizable(v) {
+                let w = v.witness.as_ref().expect("witness");
+                assert!(v.verification.as_ref().is_some_and(|c| c.passed));
+                assert!(
+                    w.counterweights
+                        .iter()
+                        .all(|c| c.mass >= hints.mass_floor())
+                );
+                assert!(
+                    w.springs
+                        .iter()
+                        .all(|s| s.stiffness >= hints.stiffness_floor())
+                );
+            } else {
+                assert!(v.reason.is_some(), "{:?}", labels(v));
+            }
+        }
+    }
+}
+
+/// Sets floating point called infeasible although a subset balances, or balanced with
+/// nanonewton springs.
+#[test]
+fn the_sets_floating_point_got_wrong_are_decided_with_proofs() {
+    let report = run(&model_of(&palletizer_json()), 3);
+    for set in [
+        ["K32", "K54", "K63"],
+        ["K63", "K65", "K72"],
+        ["K64", "K72", "K73"],
+    ] {
+        let v = find(&report, &set);
+        assert!(realizable(v), "{set:?}: {:?} {:?}", v.status, v.reason);
+    }
+    // {K32, K63} ⊂ {K32, K54, K63} balances, so the superset is at least consistent.
+    assert!(realizable(find(&report, &["K32", "K63"])));
+    // K21 + K51 = 0 on every solution: no pair of positive stiffnesses.
+    let v = find(&report, &["K21", "K51", "m4"]);
+    assert_eq!(v.status, Status::Unrealizable);
+    let reason = v.reason.as_deref().unwrap();
+    assert!(reason.contains("K21 + K51 = 0 ≤ 0"), "{reason}");
+}
+
+/// Lifted consistency is monotone: extra elements may be set to zero, so every superset of a
+/// consistent set is consistent and its rank is never lower.
+#[test]
+fn lifted_consistency_is_monotone_over_every_dmax3_variant() {
+    let model = model_of(&palletizer_json());
+    let energy = mechanism_energy(&model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+    let basis = LiftedBasis::build(&energy, &catalogue);
+    let exact = basis.exact.as_ref().expect("exact case");
+    let sets: Vec<Vec<usize>> =
+        counterpoise_balance::enumerate::variants(catalogue.len(), 3).collect();
+    let facts: HashMap<Vec<usize>, (bool, usize)> = sets
+        .iter()
+        .map(|s| {
+            let solution = exact.solve(s);
+            (s.clone(), (solution.consistent(), solution.rank()))
+        })
+        .collect();
+    let mut checked = 0;
+    for (set, &(consistent, rank)) in &facts {
+        if set.len() == 3 {
+            continue;
+        }
+        for e in (0..catalogue.len()).filter(|e| !set.contains(e)) {
+            let mut superset = set.clone();
+            superset.push(e);
+            superset.sort_unstable();
+            let (super_consistent, super_rank) = facts[&superset];
+            assert!(super_rank >= rank, "{set:?} + {e}");
+            assert!(!consistent || super_consistent, "{set:?} + {e}");
+            checked += 1;
+        }
+    }
+    // Every set of one or two elements has 27 or 26 one-element extensions: 28·27 + 378·26.
+    assert_eq!(checked, 28 * 27 + 378 * 26);
+}
+
+/// Where the floating-point path is confident (no ambiguous singular value or residual), it
+/// agrees with the exact one on consistency and rank.
+#[test]
+fn floating_point_agrees_with_exact_arithmetic_where_it_is_confident() {
+    let model = model_of(&palletizer_json());
+    let energy = mechanism_energy(&model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+    let basis = LiftedBasis::build(&energy, &catalogue);
+    let exact = basis.exact.as_ref().expect("exact case");
+    let mut confident = 0;
+    for set in counterpoise_balance::enumerate::variants(catalogue.len(), 3) {
+        let numeric = numeric_solve(&basis, &set);
+        if numeric.ambiguity.is_some() {
+            continue;
+        }
+        confident += 1;
+        let solution = exact.solve(&set);
+        assert_eq!(numeric.consistent, solution.consistent(), "{set:?}");
+        assert_eq!(numeric.rank, solution.rank(), "{set:?}");
+    }
+    // Most variants are clear-cut in floating point too.
+    assert!(confident > 3000, "{confident} of 3682 confident");
+}
+
+/// A one-ulp change of a decimal input is a different rational, not a flipped threshold: every
+/// verdict stays.
+#[test]
+fn one_ulp_changes_of_inputs_keep_every_verdict() {
+    let base = palletizer_json();
+    let reference: Vec<(Vec<String>, Status)> = run(&model_of(&base), 2)
+        .variants
+        .iter()
+        .map(|v| (labels(v), v.status))
+        .collect();
+    let next_up = |x: f64| f64::from_bits(x.to_bits() + 1);
+    let mut edits: Vec<Box<dyn Fn(&mut serde_json::Value)>> = Vec::new();
+    for p in ["d1", "d2", "d3", "d4"] {
+        edits.push(Box::new(move |c: &mut serde_json::Value| {
+            let x = c["parameters"][p].as_f64().unwrap();
+            c["parameters"][p] = serde_json::json!(next_up(x));
+        }));
+    }
+    for b in [0, 3, 6] {
+        edits.push(Box::new(move |c: &mut serde_json::Value| {
+            let x = c["bodies"][b]["mass"].as_f64().unwrap();
+            c["bodies"][b]["mass"] = serde_json::json!(next_up(x));
+        }));
+    }
+    edits.push(Box::new(|c: &mut serde_json::Value| {
+        let x = c["bodies"][3]["com"][0].as_f64().unwrap();
+        c["bodies"][3]["com"][0] = serde_json::json!(next_up(x));
+    }));
+    edits.push(Box::new(|c: &mut serde_json::Value| {
+        c["gravity"][1] = serde_json::json!(next_up(-9.81));
+    }));
+    for edit in edits {
+        let mut case = base.clone();
+        edit(&mut case);
+        let verdicts: Vec<(Vec<String>, Status)> = run(&model_of(&case), 2)
+            .variants
+            .iter()
+            .map(|v| (labels(v), v.status))
+            .collect();
+        assert_eq!(verdicts, reference);
+    }
+}
+
+/// An idle element really contributes nothing: its own energy, computed here from the model's
+/// numeric kinematics (not the balance crate), is constant over random configurations.
+#[test]
+fn idle_elements_contribute_no_energy() {
+    let model = model_of(&palletizer_json());
+    let report = run(&model, 2);
+    let kinematics = Kinematics::new(&model);
+    let g = model.gravity;
+    let degenerate: Vec<&VariantResult> = report
+        .variants
+        .iter()
+        .filter(|v| v.status == Status::Degenerate)
+        .collect();
+    assert_eq!(degenerate.len(), 6);
+    let mut rng = SplitMix64::new(7);
+    for v in degenerate {
+        assert!(!v.idle.is_empty());
+        let w: &Witness = v.witness.as_ref().unwrap();
+        for label in &v.idle {
+            let energy_at = |q: &DVector<f64>| -> f64 {
+                let poses = kinematics.body_poses(q);
+                let entry = v.elements.iter().find(|e| &e.label == label).unwrap().entry;
+                if let Some(c) = w.counterweights.iter().find(|c| c.entry == entry) {
+                    let p = &poses[c.body];
+                    let at = p.position + p.rotation * Vector3::from(c.offset);
+                    return -c.mass * g.dot(&at);
+                }
+                let s = w.springs.iter().find(|s| s.entry == entry).unwrap();
+                let p = &poses[s.body];
+                let a = p.position + p.rotation * Vector3::from(s.anchor_a);
+                let b = match s.other {
+                    counterpoise_balance::Attachment::Base => Vector3::from(s.anchor_b),
+                    counterpoise_balance::Attachment::Body(o) => {
+                        poses[o].position + poses[o].rotation * Vector3::from(s.anchor_b)
+                    }
+                };
+                0.5 * s.stiffness * (a - b).norm_squared()
+            };
+            let values: Vec<f64> = (0..100)
+                .map(|_| {
+                    let q = DVector::from_iterator(
+                        model.dof(),
+                        model
+                            .coordinates
+                            .iter()
+                            .map(|c| rng.uniform(c.range[0], c.range[1])),
+                    );
+                    energy_at(&q)
+                })
+                .collect();
+            let (lo, hi) = values
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+                    (l.min(x), h.max(x))
+                });
+            assert!(
+                hi - lo < 1e-6 * (1.0 + hi.abs()),
+                "{label} in {:?}",
+                labels(v)
+            );
+        }
+    }
+}
+
+/// A spring forced to zero stiffness is unrealizable (not an idle part), with the reason.
+#[test]
+fn forced_zero_stiffness_is_unrealizable() {
+    let report = run(&model_of(&palletizer_json()), 1);
+    let v = find(&report, &["K41"]);
+    assert_eq!(v.status, Status::Unrealizable);
+    assert_eq!(
+        v.reason.as_deref(),
+        Some("K41: balance forces its stiffness to zero")
+    );
+}
+
+/// Relations are printed exactly: m4 alone needs m = 672.843375 / (9.81 · 0.3) kg (palletizer.md:
+/// the sin θ2 coefficient of V_UB over g·δ1), which is 1829/8.
+#[test]
+fn relations_are_exact_fractions() {
+    let report = run(&model_of(&palletizer_json()), 1);
+    let v = find(&report, &["m4"]);
+    let expected: f64 = 672.843375 / (9.81 * 0.3);
+    assert!((expected - 1829.0 / 8.0).abs() < 1e-9);
+    assert_eq!(v.relations[0], "m4 = 1829/8 (228.625) kg");
+}
+
+/// A constant rotation of the column about the vertical axis leaves the potential unchanged: by
+/// an irrational angle the case takes the numeric path, by atan2(4, 3) it stays exact, and both
+/// reach the exact verdicts (the numeric path at most says undecided, never the opposite).
+#[test]
+fn rotated_column_takes_the_right_path_and_keeps_the_verdicts() {
+    let base = palletizer_json();
+    let reference = run(&model_of(&base), 2);
+    for (angle, decision) in [
+        ("th1 + 0.3", Decision::Numeric),
+        ("th1 + atan2(4, 3)", Decision::Exact),
+    ] {
+        let mut case = base.clone();
+        case["bodies"][0]["pose"][0]["rot_y"] = serde_json::json!(angle);
+        let model = model_of(&case);
+        let energy = mechanism_energy(&model);
+        assert_eq!(energy.exact.is_ok(), decision == Decision::Exact, "{angle}");
+        let report = run(&model, 2);
+        let mut undecided = 0;
+        for (v, r) in report.variants.iter().zip(&reference.variants) {
+            assert_eq!(v.decision, decision);
+            if v.status == Status::Undecided {
+                undecided += 1;
+                continue;
+            }
+            assert_eq!(
+                v.status,
+                r.status,
+                "{angle}: {:?} {:?}",
+                labels(v),
+                v.reason
+            );
+        }
+        if decision == Decision::Exact {
+            assert_eq!(undecided, 0);
+        }
+    }
+    let mut case = base.clone();
+    case["bodies"][0]["pose"][0]["rot_y"] = serde_json::json!("th1 + 0.3");
+    let reason = mechanism_energy(&model_of(&case)).exact.unwrap_err();
+    assert!(reason.starts_with("bodies[0].pose[0].rot_y"), "{reason}");
+}
