@@ -154,6 +154,11 @@ pub fn summary(model: &Model) -> String {
                 b.dmax
             ),
         );
+        let decision = match counterpoise_model::exact_mechanism(model) {
+            Ok(_) => "exact (every number of the case is rational)".to_string(),
+            Err(e) => format!("numeric, with an ambiguous zone reported as undecided ({e})"),
+        };
+        line(&mut out, format!("balance decision: {decision}"));
     }
     out
 }

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use counterpoise_balance::{
-    Attachment, Catalogue, Class, SearchOptions, SearchReport, Status, VariantResult,
+    Attachment, Catalogue, Class, Decision, SearchOptions, SearchReport, Status, VariantResult,
     catalogue_options, mechanism_energy, realization_hints, search,
 };
 use counterpoise_model::{Model, Plane};
@@ -155,6 +155,25 @@ pub fn witness_lines(model: &Model, v: &VariantResult) -> Vec<String> {
     lines
 }
 
+/// Which arithmetic decided the variants, in one line.
+fn decision_line(report: &SearchReport) -> String {
+    let exact = report
+        .variants
+        .iter()
+        .filter(|v| v.decision == Decision::Exact)
+        .count();
+    if exact == report.variants.len() {
+        "decided in exact rational arithmetic\n".to_string()
+    } else {
+        format!(
+            "decided in floating point with an ambiguous zone ({} of {} exactly): the case has an \
+             irrational constant (see `check`)\n",
+            exact,
+            report.variants.len()
+        )
+    }
+}
+
 /// The human-readable report.
 pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -> String {
     let mut out = String::new();
@@ -179,6 +198,11 @@ pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -
         }
         out.push_str(&format!("{:>10}\n", report.count(status)));
     }
+    out.push_str(&format!(
+        "realizable (balanced + degenerate): {}\n",
+        report.count(Status::Balanced) + report.count(Status::Degenerate)
+    ));
+    out.push_str(&decision_line(report));
     out.push('\n');
     for v in report
         .variants
@@ -204,6 +228,28 @@ pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -
         }
         for r in &v.relations {
             out.push_str(&format!("    relation: {r}\n"));
+        }
+        for r in &v.ranges {
+            out.push_str(&format!(
+                "    range: {} ∈ {} {}\n",
+                r.variable, r.interval, r.unit
+            ));
+        }
+    }
+    let degenerate: Vec<&VariantResult> = report
+        .variants
+        .iter()
+        .filter(|v| v.status == Status::Degenerate)
+        .collect();
+    if !degenerate.is_empty() {
+        out.push_str("\ndegenerate (realizable, but some element can only idle):\n");
+        for v in degenerate {
+            let labels: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
+            out.push_str(&format!(
+                "{{{}}}  idle: {}\n",
+                labels.join(", "),
+                v.idle.join(", ")
+            ));
         }
     }
     let others: Vec<&VariantResult> = report

@@ -76,7 +76,12 @@ pub fn exact_mechanism(model: &Model) -> Result<ExactMechanism, NotExact> {
     let first_error = |errors: Vec<crate::ModelError>, path: String| -> NotExact {
         errors.into_iter().next().map_or_else(
             || not_exact(path, "not exact"),
-            |e| not_exact(e.path().to_string(), e.to_string()),
+            |e| {
+                let path = e.path().to_string();
+                let text = e.to_string();
+                let reason = text.strip_prefix(&format!("{path}: ")).unwrap_or(&text);
+                not_exact(path.clone(), reason.to_string())
+            },
         )
     };
     let mut relative = Vec::with_capacity(case.bodies.len());
