@@ -8,6 +8,7 @@ use counterpoise_symbolic::{ExprContext, LinearAngle, PolyMat3, PolyVec3, TrigPo
 
 use crate::case::{Expr, PoseStep};
 use crate::error::ModelError;
+use crate::limits::MAX_POSE_DEGREE;
 
 /// A rigid transform `x ↦ R x + p` with polynomial entries.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,14 +25,41 @@ impl PolyPose {
         }
     }
 
-    /// `self · (translation t)`.
-    fn translate(&mut self, t: &PolyVec3) {
-        self.origin = self.origin.add(&self.rotation.mul_vec(t));
+    /// Highest power of one coordinate in the pose (rotation and origin).
+    pub fn degree(&self) -> u32 {
+        let rotation = self.rotation.0.iter().flatten().map(TrigPoly::max_power);
+        let origin = self.origin.0.iter().map(TrigPoly::max_power);
+        rotation.chain(origin).max().unwrap_or(0)
     }
 
-    /// `self · (rotation r)`.
-    fn rotate(&mut self, r: &PolyMat3) {
+    /// `self · (translation t)`, refused when the product would pass [`MAX_POSE_DEGREE`] (the
+    /// symbolic core stores powers in a byte: an unchecked product could overflow it).
+    fn translate(&mut self, t: &PolyVec3, path: &str) -> Result<(), ModelError> {
+        let step = t.0.iter().map(TrigPoly::max_power).max().unwrap_or(0);
+        self.check_degree(step, path)?;
+        self.origin = self.origin.add(&self.rotation.mul_vec(t));
+        Ok(())
+    }
+
+    /// `self · (rotation r)`, refused like [`PolyPose::translate`].
+    fn rotate(&mut self, r: &PolyMat3, path: &str) -> Result<(), ModelError> {
+        let step = r.0.iter().flatten().map(TrigPoly::max_power).max().unwrap_or(0);
+        self.check_degree(step, path)?;
         self.rotation = self.rotation.mul_mat(r);
+        Ok(())
+    }
+
+    fn check_degree(&self, step: u32, path: &str) -> Result<(), ModelError> {
+        let degree = self.degree() + step;
+        if degree > MAX_POSE_DEGREE {
+            return Err(ModelError::invalid(
+                path,
+                format!(
+                    "the pose reaches degree {degree} in one coordinate; at most {MAX_POSE_DEGREE} is supported"
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// `self · other`.
@@ -184,25 +212,29 @@ impl Parser<'_> {
                 if !errors.is_empty() {
                     return Err(errors);
                 }
-                pose.translate(&PolyVec3(entries));
+                pose.translate(&PolyVec3(entries), path)
+                    .map_err(|e| vec![e])?;
             }
             PoseStep::RotX(e) => {
                 let a = self
                     .angle(e, &format!("{path}.rot_x"))
                     .map_err(|e| vec![e])?;
-                pose.rotate(&PolyMat3::rot_x(&a));
+                pose.rotate(&PolyMat3::rot_x(&a), path)
+                    .map_err(|e| vec![e])?;
             }
             PoseStep::RotY(e) => {
                 let a = self
                     .angle(e, &format!("{path}.rot_y"))
                     .map_err(|e| vec![e])?;
-                pose.rotate(&PolyMat3::rot_y(&a));
+                pose.rotate(&PolyMat3::rot_y(&a), path)
+                    .map_err(|e| vec![e])?;
             }
             PoseStep::RotZ(e) => {
                 let a = self
                     .angle(e, &format!("{path}.rot_z"))
                     .map_err(|e| vec![e])?;
-                pose.rotate(&PolyMat3::rot_z(&a));
+                pose.rotate(&PolyMat3::rot_z(&a), path)
+                    .map_err(|e| vec![e])?;
             }
             PoseStep::Dh(dh) => {
                 let theta = self.angle(&dh.theta, &format!("{path}.dh.theta"));
@@ -212,9 +244,13 @@ impl Parser<'_> {
                 match (theta, d, a, alpha) {
                     (Ok(theta), Ok(d), Ok(a), Ok(alpha)) => {
                         // Rz(theta)·Tz(d)·Tx(a)·Rx(alpha)
-                        pose.rotate(&PolyMat3::rot_z(&theta));
-                        pose.translate(&PolyVec3([a, TrigPoly::zero(), d]));
-                        pose.rotate(&PolyMat3::rot_x(&alpha));
+                        let steps = pose
+                            .rotate(&PolyMat3::rot_z(&theta), path)
+                            .and_then(|()| {
+                                pose.translate(&PolyVec3([a, TrigPoly::zero(), d]), path)
+                            })
+                            .and_then(|()| pose.rotate(&PolyMat3::rot_x(&alpha), path));
+                        steps.map_err(|e| vec![e])?;
                     }
                     (theta, d, a, alpha) => {
                         let mut errors = Vec::new();
