@@ -79,7 +79,8 @@ impl ModelError {
         }
     }
 
-    pub(crate) fn invalid(path: impl Into<String>, reason: impl Into<String>) -> ModelError {
+    /// A value out of its domain at `path`.
+    pub fn invalid(path: impl Into<String>, reason: impl Into<String>) -> ModelError {
         ModelError::Invalid {
             path: path.into(),
             reason: reason.into(),
@@ -104,8 +105,8 @@ impl CaseErrors {
     }
 
     /// Sorts the errors by path (array indices numerically; a stable sort keeps the order of
-    /// errors on the same field) and locates each in `text`.
-    pub(crate) fn sorted_and_located(mut errors: Vec<ModelError>, text: &str) -> CaseErrors {
+    /// errors on the same field) and locates each in `text`, the case file's text.
+    pub fn sorted_and_located(mut errors: Vec<ModelError>, text: &str) -> CaseErrors {
         errors.sort_by_cached_key(|e| path_key(e.path()));
         let paths: Vec<&str> = errors.iter().map(ModelError::path).collect();
         let found = crate::locate::positions(text, &paths);
@@ -116,6 +117,8 @@ impl CaseErrors {
                     line: *line,
                     column: *column,
                 }),
+                // A command-line option (`--dmax`) is not in the file.
+                _ if e.path().starts_with("--") => None,
                 _ => found.get(e.path()).copied(),
             })
             .collect();

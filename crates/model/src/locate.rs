@@ -57,8 +57,9 @@ struct Visit<'p> {
 }
 
 /// Walks the text up to `stop`, calling `visit` for every object member (at its key) and
-/// every array element and the root (at its value). Returns the path being read at `stop`.
-fn scan(text: &str, stop: usize, mut visit: impl FnMut(Visit)) -> String {
+/// every array element and the root (at its value); `visit` returns `false` to stop early.
+/// Returns the path being read where it stopped.
+fn scan(text: &str, stop: usize, mut visit: impl FnMut(Visit) -> bool) -> String {
     let b = text.as_bytes();
     let stop = stop.min(b.len());
     let mut path = String::new();
@@ -66,20 +67,22 @@ fn scan(text: &str, stop: usize, mut visit: impl FnMut(Visit)) -> String {
     let mut expect_key = false;
     let mut i = 0;
     // An array element or the root starts at its value; an object member at its key.
-    let value_start = |stack: &Vec<Frame>, path: &str, at: usize, visit: &mut dyn FnMut(Visit)| {
-        if matches!(stack.last(), None | Some(Frame::Array { .. })) {
-            visit(Visit {
-                path: if path.is_empty() { "." } else { path },
-                offset: at,
-                duplicate: false,
-            });
-        }
-    };
+    let value_start =
+        |stack: &Vec<Frame>, path: &str, at: usize, visit: &mut dyn FnMut(Visit) -> bool| {
+            !matches!(stack.last(), None | Some(Frame::Array { .. }))
+                || visit(Visit {
+                    path: if path.is_empty() { "." } else { path },
+                    offset: at,
+                    duplicate: false,
+                })
+        };
     while i < stop {
         match b[i] {
             b' ' | b'\t' | b'\n' | b'\r' | b':' => i += 1,
             b'{' => {
-                value_start(&stack, &path, i, &mut visit);
+                if !value_start(&stack, &path, i, &mut visit) {
+                    break;
+                }
                 stack.push(Frame::Object {
                     base: path.len(),
                     keys: HashSet::new(),
@@ -88,7 +91,9 @@ fn scan(text: &str, stop: usize, mut visit: impl FnMut(Visit)) -> String {
                 i += 1;
             }
             b'[' => {
-                value_start(&stack, &path, i, &mut visit);
+                if !value_start(&stack, &path, i, &mut visit) {
+                    break;
+                }
                 stack.push(Frame::Array {
                     base: path.len(),
                     index: 0,
@@ -107,14 +112,17 @@ fn scan(text: &str, stop: usize, mut visit: impl FnMut(Visit)) -> String {
                     }
                     path.push_str(&key);
                     let duplicate = !keys.insert(key);
-                    visit(Visit {
+                    let go_on = visit(Visit {
                         path: &path,
                         offset: i,
                         duplicate,
                     });
+                    if !go_on {
+                        break;
+                    }
                     expect_key = false;
-                } else {
-                    value_start(&stack, &path, i, &mut visit);
+                } else if !value_start(&stack, &path, i, &mut visit) {
+                    break;
                 }
                 i = end;
             }
@@ -138,7 +146,9 @@ fn scan(text: &str, stop: usize, mut visit: impl FnMut(Visit)) -> String {
                 i += 1;
             }
             _ => {
-                value_start(&stack, &path, i, &mut visit);
+                if !value_start(&stack, &path, i, &mut visit) {
+                    break;
+                }
                 while i < b.len()
                     && !matches!(b[i], b',' | b']' | b'}' | b' ' | b'\t' | b'\n' | b'\r')
                 {
@@ -181,7 +191,7 @@ fn decode_key(quoted: &str) -> String {
 
 /// The path of the member or element being read at byte `offset` (`.` at the top level).
 pub fn path_at(text: &str, offset: usize) -> String {
-    scan(text, offset, |_| {})
+    scan(text, offset, |_| true)
 }
 
 /// Paths of keys that repeat a key of the same object, with their positions.
@@ -191,6 +201,7 @@ pub fn duplicate_keys(text: &str) -> Vec<(String, Position)> {
         if v.duplicate {
             found.push((v.path.to_string(), v.offset));
         }
+        true
     });
     found
         .into_iter()
@@ -208,10 +219,12 @@ pub fn positions(text: &str, paths: &[&str]) -> HashMap<String, Position> {
         }
     }
     let mut offsets: HashMap<String, usize> = HashMap::new();
+    let total = wanted.len();
     scan(text, text.len(), |v| {
         if wanted.contains(v.path) && !offsets.contains_key(v.path) {
             offsets.insert(v.path.to_string(), v.offset);
         }
+        offsets.len() < total
     });
     let mut out = HashMap::new();
     for p in paths {

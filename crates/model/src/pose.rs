@@ -183,8 +183,13 @@ impl Parser<'_> {
         for (n, step) in steps.iter().enumerate() {
             let step_path = format!("{path}[{n}]");
             if let Err(e) = self.apply_step(&mut pose, step, &step_path) {
+                // Past the degree limit every further step fails the same way: report it once.
+                let degree = e.iter().any(|e| e.to_string().contains("pose reaches degree"));
                 errors.extend(e);
                 ok = false;
+                if degree {
+                    break;
+                }
             }
         }
         ok.then(|| {

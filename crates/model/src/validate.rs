@@ -57,6 +57,16 @@ pub const MAX_DENSITY: f64 = 1e6;
 /// not tasks.
 pub const DURATION_RANGE: [f64; 2] = [1e-3, 1e6];
 
+/// A number for a message: plain when moderate, in exponent form when huge or tiny (`1e308`
+/// is not printed as 309 digits).
+fn num(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e9).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 /// Names the expression language reserves.
 const RESERVED: [&str; 3] = ["pi", "cos", "sin"];
 
@@ -77,7 +87,11 @@ impl Validator {
         if value.abs() > max {
             self.invalid(
                 path,
-                format!("{value} {unit} is beyond the supported magnitude ±{max} {unit}"),
+                format!(
+                    "{} {unit} is beyond the supported magnitude ±{} {unit}",
+                    num(value),
+                    num(max)
+                ),
             );
             return false;
         }
@@ -105,7 +119,10 @@ impl Validator {
         if !(value.is_finite() && (lo..=hi).contains(&value)) {
             self.invalid(
                 path,
-                format!("must be a duration between {lo} and {hi} s (found {value})"),
+                format!(
+                    "must be a duration between {lo} and {hi} s (found {})",
+                    num(value)
+                ),
             );
             return false;
         }
@@ -187,7 +204,7 @@ impl Validator {
 
     fn positive(&mut self, value: f64, path: &str) -> bool {
         if !(value.is_finite() && value > 0.0) {
-            self.invalid(path, format!("must be a finite number > 0 (found {value})"));
+            self.invalid(path, format!("must be a finite number > 0 (found {})", num(value)));
             return false;
         }
         true
@@ -200,7 +217,7 @@ impl Validator {
 
     fn non_negative(&mut self, value: f64, path: &str) -> bool {
         if !(value.is_finite() && value >= 0.0) {
-            self.invalid(path, format!("must be a finite number ≥ 0 (found {value})"));
+            self.invalid(path, format!("must be a finite number ≥ 0 (found {})", num(value)));
             return false;
         }
         true
@@ -751,7 +768,9 @@ fn pose_in_bounds(v: &mut Validator, pose: &PolyPose, path: &str) -> bool {
         v.invalid(
             path,
             format!(
-                "its translations reach {largest} m, beyond the supported magnitude ±{MAX_LENGTH} m"
+                "its translations reach {} m, beyond the supported magnitude ±{} m",
+                num(largest),
+                num(MAX_LENGTH)
             ),
         );
         return false;
