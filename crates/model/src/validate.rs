@@ -84,11 +84,16 @@ struct Validator {
 impl Validator {
     /// Checks `|value| ≤ max` (the value is already known finite or reported).
     fn magnitude(&mut self, value: f64, max: f64, path: &str, unit: &str) -> bool {
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
         if value.abs() > max {
             self.invalid(
                 path,
                 format!(
-                    "{} {unit} is beyond the supported magnitude ±{} {unit}",
+                    "{}{unit} is beyond the supported magnitude ±{}{unit}",
                     num(value),
                     num(max)
                 ),
