@@ -238,7 +238,10 @@ pub fn before_run(path: &std::path::Path, model: &Model, dmax_given: bool, dmax:
     } else {
         "balancing.dmax"
     };
-    let mut problems: Vec<ModelError> = variant_guard(model, dmax, source).err().into_iter().collect();
+    let mut problems: Vec<ModelError> = variant_guard(model, dmax, source)
+        .err()
+        .into_iter()
+        .collect();
     problems.extend(path_problems(model));
     if problems.is_empty() {
         return true;
@@ -268,7 +271,11 @@ pub fn problems(model: &Model) -> (Vec<ModelError>, Option<GridReach>) {
     if let Some(r) = &reach
         && r.evaluable == 0
     {
-        let reasons: Vec<String> = r.by_reason.iter().map(|(k, n)| format!("{k} {n}")).collect();
+        let reasons: Vec<String> = r
+            .by_reason
+            .iter()
+            .map(|(k, n)| format!("{k} {n}"))
+            .collect();
         problems.push(ModelError::invalid(
             "tasks.grid",
             format!(
@@ -289,7 +296,10 @@ mod tests {
     fn the_estimate_matches_the_exact_count_and_does_not_overflow() {
         for (e, d) in [(28u64, 2u64), (28, 3), (28, 4), (5, 9)] {
             let exact = variant_count(e, 0, d) as f64;
-            assert!((variant_estimate(e, d) - exact).abs() <= 1e-9 * exact, "{e} {d}");
+            assert!(
+                (variant_estimate(e, d) - exact).abs() <= 1e-9 * exact,
+                "{e} {d}"
+            );
         }
         // 35 elements (7 bodies, springs to the base), Dmax 50: every subset, 2^35 − 1.
         assert_eq!(variant_estimate(35, 50), 2f64.powi(35) - 1.0);

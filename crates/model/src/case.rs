@@ -17,7 +17,6 @@ use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::ser::{SerializeMap, Serializer};
 use serde::{Deserialize, Serialize};
 
-
 /// A case-language expression: a string such as `"d2 + d1*sin(th2)"`, or a plain number.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expr {
@@ -445,4 +444,3 @@ pub struct PathPayloadSpec {
     pub pick_at: String,
     pub drop_at: String,
 }
-

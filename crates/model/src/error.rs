@@ -127,9 +127,12 @@ impl CaseErrors {
 
     /// Each error with its position.
     pub fn located(&self) -> impl Iterator<Item = (&ModelError, Option<Position>)> {
-        self.errors
-            .iter()
-            .zip(self.positions.iter().copied().chain(std::iter::repeat(None)))
+        self.errors.iter().zip(
+            self.positions
+                .iter()
+                .copied()
+                .chain(std::iter::repeat(None)),
+        )
     }
 
     /// One line per error: the error, then its line and column where the text has them.

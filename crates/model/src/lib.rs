@@ -27,8 +27,8 @@ use std::path::Path;
 
 pub use case::Case;
 pub use error::{CaseErrors, ModelError, Position};
-pub use limits::{Limit, Limits};
 pub use kinematics::{BodyJacobian, BodyMotion, Kinematics, Pose};
+pub use limits::{Limit, Limits};
 pub use model::{
     Actuator, ActuatorMap, Balancing, Body, BodyId, Bounds, Coordinate, CounterweightOptions,
     CounterweightShape, GridAxis, Joint, JointKind, Model, MotionLaw, PairMode, PathPayload,

@@ -201,10 +201,7 @@ impl FromStr for Limit {
             .find(|l| l.name() == name)
             .ok_or_else(|| {
                 let names: Vec<&str> = Limit::ALL.iter().map(|l| l.name()).collect();
-                format!(
-                    "unknown limit `{name}` (one of {})",
-                    names.join(", ")
-                )
+                format!("unknown limit `{name}` (one of {})", names.join(", "))
             })
     }
 }
@@ -238,7 +235,12 @@ mod tests {
         assert_eq!(limits.get(Limit::Variants), 1_000_000);
         assert!(limits.apply("grid-points=0").is_err());
         assert!(limits.apply("grid-points=2.5").is_err());
-        assert!(limits.apply("gridpoints=5").unwrap_err().contains("grid-points"));
+        assert!(
+            limits
+                .apply("gridpoints=5")
+                .unwrap_err()
+                .contains("grid-points")
+        );
         assert!(limits.apply("samples").is_err());
         for limit in Limit::ALL {
             assert_eq!(limit.name().parse::<Limit>(), Ok(limit));

@@ -228,10 +228,7 @@ pub fn positions(text: &str, paths: &[&str]) -> HashMap<String, Position> {
     });
     let mut out = HashMap::new();
     for p in paths {
-        if let Some(at) = ancestors(p)
-            .chain(["."])
-            .find_map(|a| offsets.get(a))
-        {
+        if let Some(at) = ancestors(p).chain(["."]).find_map(|a| offsets.get(a)) {
             out.insert(p.to_string(), position(text, *at));
         }
     }
@@ -262,10 +259,22 @@ mod tests {
         let found = positions(TEXT, &["a", "b[1].c[1]", "d.e\"", "b[0].zz", "."]);
         assert_eq!(found["a"], Position { line: 2, column: 3 });
         // `[1, 2]` of the second element: the element `2` is at column 33 of line 3.
-        assert_eq!(found["b[1].c[1]"], Position { line: 3, column: 33 });
+        assert_eq!(
+            found["b[1].c[1]"],
+            Position {
+                line: 3,
+                column: 33
+            }
+        );
         assert_eq!(found["d.e\""], Position { line: 4, column: 9 });
         // a missing member is located at its parent
-        assert_eq!(found["b[0].zz"], Position { line: 3, column: 10 });
+        assert_eq!(
+            found["b[0].zz"],
+            Position {
+                line: 3,
+                column: 10
+            }
+        );
         assert_eq!(found["."], Position { line: 1, column: 1 });
     }
 

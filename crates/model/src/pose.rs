@@ -43,7 +43,12 @@ impl PolyPose {
 
     /// `self · (rotation r)`, refused like [`PolyPose::translate`].
     fn rotate(&mut self, r: &PolyMat3, path: &str) -> Result<(), ModelError> {
-        let step = r.0.iter().flatten().map(TrigPoly::max_power).max().unwrap_or(0);
+        let step =
+            r.0.iter()
+                .flatten()
+                .map(TrigPoly::max_power)
+                .max()
+                .unwrap_or(0);
         self.check_degree(step, path)?;
         self.rotation = self.rotation.mul_mat(r);
         Ok(())
@@ -184,7 +189,9 @@ impl Parser<'_> {
             let step_path = format!("{path}[{n}]");
             if let Err(e) = self.apply_step(&mut pose, step, &step_path) {
                 // Past the degree limit every further step fails the same way: report it once.
-                let degree = e.iter().any(|e| e.to_string().contains("pose reaches degree"));
+                let degree = e
+                    .iter()
+                    .any(|e| e.to_string().contains("pose reaches degree"));
                 errors.extend(e);
                 ok = false;
                 if degree {

@@ -32,7 +32,13 @@ pub(crate) fn clip(text: &str) -> String {
     }
 }
 
-pub(crate) fn too_large(path: &str, what: &str, found: f64, limit: Limit, value: u64) -> ModelError {
+pub(crate) fn too_large(
+    path: &str,
+    what: &str,
+    found: f64,
+    limit: Limit,
+    value: u64,
+) -> ModelError {
     ModelError::invalid(
         path,
         format!(
@@ -54,8 +60,15 @@ pub(crate) fn read_text(path: &std::path::Path, limits: &Limits) -> Result<Strin
     };
     let file = std::fs::File::open(path).map_err(io)?;
     let size = file.metadata().map_err(io)?.len();
-    let oversize =
-        |n: u64| too_large(".", "bytes in the file", n as f64, Limit::FileBytes, limits.file_bytes);
+    let oversize = |n: u64| {
+        too_large(
+            ".",
+            "bytes in the file",
+            n as f64,
+            Limit::FileBytes,
+            limits.file_bytes,
+        )
+    };
     if size > limits.file_bytes {
         return Err(oversize(size));
     }
@@ -95,10 +108,7 @@ pub(crate) fn parse(text: &str, limits: &Limits) -> (Option<Case>, Vec<ModelErro
     }
 }
 
-fn parse_value(
-    text: &str,
-    limits: &Limits,
-) -> Result<(Option<Case>, Vec<ModelError>), ModelError> {
+fn parse_value(text: &str, limits: &Limits) -> Result<(Option<Case>, Vec<ModelError>), ModelError> {
     if text.len() as u64 > limits.file_bytes {
         return Err(too_large(
             ".",
@@ -336,8 +346,7 @@ impl Reader<'_> {
         };
         let name = required(self, "name").and_then(|v| self.part::<String>(v, "name"));
         let gravity = required(self, "gravity").and_then(|v| self.part(v, "gravity"));
-        let coordinates =
-            required(self, "coordinates").and_then(|v| self.list(v, "coordinates"));
+        let coordinates = required(self, "coordinates").and_then(|v| self.list(v, "coordinates"));
         let bodies = required(self, "bodies").and_then(|v| self.list(v, "bodies"));
         let actuators = required(self, "actuators").and_then(|v| self.list(v, "actuators"));
         let description = self.optional(members, "description");
@@ -415,7 +424,10 @@ mod tests {
     fn paths_join_like_serde_path_to_error() {
         assert_eq!(join(".", "a"), "a");
         assert_eq!(join("bodies[2]", "."), "bodies[2]");
-        assert_eq!(join("bodies[2]", "pose[0].rot_z"), "bodies[2].pose[0].rot_z");
+        assert_eq!(
+            join("bodies[2]", "pose[0].rot_z"),
+            "bodies[2].pose[0].rot_z"
+        );
         assert_eq!(join("bodies", "[3]"), "bodies[3]");
     }
 

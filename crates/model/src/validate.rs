@@ -14,15 +14,15 @@ use crate::case::{
     Selection, ShapeSpec, TasksSpec,
 };
 use crate::error::{CaseErrors, ModelError};
-use crate::limits::{Limit, Limits, MAX_POSE_DEGREE};
-use crate::reader::too_large;
 use crate::joints::{self, JointInput};
+use crate::limits::{Limit, Limits, MAX_POSE_DEGREE};
 use crate::model::{
     Actuator, ActuatorMap, Balancing, Body, BodyId, Bounds, Coordinate, CounterweightOptions,
     CounterweightShape, GridAxis, Joint, JointKind, Model, MotionLaw, PairMode, PathPayload,
     Payload, Plane, SpringOptions, TaskPath, Tasks, Waypoint,
 };
 use crate::pose::{Parser, PolyPose};
+use crate::reader::too_large;
 use crate::sampling::{DEFAULT_SEED, VALIDATION_SAMPLES, sample_configurations};
 
 /// Relative tolerance of the joint checks: deviations up to `JOINT_TOLERANCE · (1 + L)` pass,
@@ -209,7 +209,10 @@ impl Validator {
 
     fn positive(&mut self, value: f64, path: &str) -> bool {
         if !(value.is_finite() && value > 0.0) {
-            self.invalid(path, format!("must be a finite number > 0 (found {})", num(value)));
+            self.invalid(
+                path,
+                format!("must be a finite number > 0 (found {})", num(value)),
+            );
             return false;
         }
         true
@@ -222,7 +225,10 @@ impl Validator {
 
     fn non_negative(&mut self, value: f64, path: &str) -> bool {
         if !(value.is_finite() && value >= 0.0) {
-            self.invalid(path, format!("must be a finite number ≥ 0 (found {})", num(value)));
+            self.invalid(
+                path,
+                format!("must be a finite number ≥ 0 (found {})", num(value)),
+            );
             return false;
         }
         true
@@ -1082,13 +1088,12 @@ fn balancing(
     });
     let defaults = Bounds::default();
     let spec = b.bounds.clone().unwrap_or_default();
-    let mut bound = |value: Option<[f64; 2]>, default: [f64; 2], name: &str, max, unit| {
-        match value {
-            Some(x) => v
-                .interval(x, max, unit, &format!("balancing.bounds.{name}"))
-                .unwrap_or(default),
-            None => default,
-        }
+    let mut bound = |value: Option<[f64; 2]>, default: [f64; 2], name: &str, max, unit| match value
+    {
+        Some(x) => v
+            .interval(x, max, unit, &format!("balancing.bounds.{name}"))
+            .unwrap_or(default),
+        None => default,
     };
     let bounds = Bounds {
         mass: bound(spec.mass, defaults.mass, "mass", MAX_MASS, "kg"),
@@ -1100,8 +1105,20 @@ fn balancing(
             MAX_STIFFNESS,
             "N/m",
         ),
-        anchor_a: bound(spec.anchor_a, defaults.anchor_a, "anchor_a", MAX_LENGTH, "m"),
-        anchor_b: bound(spec.anchor_b, defaults.anchor_b, "anchor_b", MAX_LENGTH, "m"),
+        anchor_a: bound(
+            spec.anchor_a,
+            defaults.anchor_a,
+            "anchor_a",
+            MAX_LENGTH,
+            "m",
+        ),
+        anchor_b: bound(
+            spec.anchor_b,
+            defaults.anchor_b,
+            "anchor_b",
+            MAX_LENGTH,
+            "m",
+        ),
     };
     let mut peak_limits = vec![None; case.actuators.len()];
     for (name, &limit) in b.peak_limits.iter() {
@@ -1139,8 +1156,7 @@ fn tasks(
             v.unknown(&path, "actuator", name);
             continue;
         };
-        if !v.bounded(&[from, to], MAX_LENGTH.max(MAX_ANGLE), &path, "") || !v.finite(&[n], &path)
-        {
+        if !v.bounded(&[from, to], MAX_LENGTH.max(MAX_ANGLE), &path, "") || !v.finite(&[n], &path) {
             continue;
         }
         if n < 1.0 || n.fract() != 0.0 {

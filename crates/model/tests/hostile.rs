@@ -62,7 +62,10 @@ fn several_shape_errors_are_reported_together() {
     v["joints"][0]["kind"] = json!("hinge");
     let errors = errors_of(&v);
     let paths: Vec<&str> = errors.iter().map(ModelError::path).collect();
-    assert_eq!(paths, vec!["bodies[0].mass", "bodies[1].com", "joints[0].kind"]);
+    assert_eq!(
+        paths,
+        vec!["bodies[0].mass", "bodies[1].com", "joints[0].kind"]
+    );
 }
 
 #[test]
@@ -78,7 +81,10 @@ fn a_top_level_array_truncated_json_and_bad_utf8_get_sensible_messages() {
     let case = serde_json::to_string_pretty(&two_link()).unwrap();
     let array = format!("[{case}]");
     let e = Case::from_json_str(&array).unwrap_err();
-    assert!(e.to_string().contains("a case file is one JSON object"), "{e}");
+    assert!(
+        e.to_string().contains("a case file is one JSON object"),
+        "{e}"
+    );
     assert!(e.to_string().contains("found an array"), "{e}");
 
     let truncated = &case[..case.find("\"link2\"").unwrap() + 3];
@@ -208,7 +214,11 @@ fn pose_degrees_cannot_overflow() {
     let mut v = two_link();
     let mut bodies = Vec::new();
     for k in 0..4 {
-        let parent = if k == 0 { "base".to_string() } else { format!("b{}", k - 1) };
+        let parent = if k == 0 {
+            "base".to_string()
+        } else {
+            format!("b{}", k - 1)
+        };
         bodies.push(json!({ "name": format!("b{k}"), "parent": parent,
                             "pose": [ { "rot_z": "20*q1" } ], "mass": 0 }));
     }
@@ -242,8 +252,10 @@ fn a_long_parent_chain_does_not_recurse() {
             let mut v = two_link();
             let mut bodies = vec![json!({ "name": "b0", "parent": "base", "mass": 0 })];
             for k in 1..5_000 {
-                bodies.push(json!({ "name": format!("b{k}"), "parent": format!("b{}", k - 1),
-                                    "mass": 0 }));
+                bodies.push(
+                    json!({ "name": format!("b{k}"), "parent": format!("b{}", k - 1),
+                                    "mass": 0 }),
+                );
             }
             v["bodies"] = json!(bodies);
             v["joints"] = json!([]);

@@ -592,7 +592,11 @@ impl Parser<'_> {
             let rhs = self.expression(right)?;
             let span = lhs.span.join(rhs.span);
             let depth = lhs.depth.max(rhs.depth);
-            lhs = self.node(NodeKind::Binary(op, Box::new(lhs), Box::new(rhs)), span, depth)?;
+            lhs = self.node(
+                NodeKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+                span,
+                depth,
+            )?;
         }
         Ok(lhs)
     }
@@ -769,8 +773,14 @@ mod tests {
             assert!(src.len() <= MAX_EXPRESSION_LENGTH);
             let shown = src.chars().take(20).collect::<String>();
             let err = on_small_stack(move || context().parse_poly(&src).unwrap_err());
-            assert!(err.reason.contains(&format!("deeper than {depth}")), "{shown}: {err}");
-            assert!(err.expr.chars().count() <= 121, "the error quotes a clipped expression");
+            assert!(
+                err.reason.contains(&format!("deeper than {depth}")),
+                "{shown}: {err}"
+            );
+            assert!(
+                err.expr.chars().count() <= 121,
+                "the error quotes a clipped expression"
+            );
         }
     }
 
@@ -792,12 +802,21 @@ mod tests {
         // no tree level; each unary minus adds one of both.
         let n = MAX_EXPRESSION_DEPTH;
         let sum = vec!["1"; n].join("+");
-        assert_eq!(on_small_stack(move || context().parse_constant(&sum)), Ok(n as f64));
+        assert_eq!(
+            on_small_stack(move || context().parse_constant(&sum)),
+            Ok(n as f64)
+        );
         let parens = format!("{}2{}", "(".repeat(n - 1), ")".repeat(n - 1));
-        assert_eq!(on_small_stack(move || context().parse_constant(&parens)), Ok(2.0));
+        assert_eq!(
+            on_small_stack(move || context().parse_constant(&parens)),
+            Ok(2.0)
+        );
         let minus = format!("{}3", "-".repeat(n - 1));
         let expected = if (n - 1) % 2 == 0 { 3.0 } else { -3.0 };
-        assert_eq!(on_small_stack(move || context().parse_constant(&minus)), Ok(expected));
+        assert_eq!(
+            on_small_stack(move || context().parse_constant(&minus)),
+            Ok(expected)
+        );
         let too_deep = vec!["1"; n + 1].join("+");
         assert!(on_small_stack(move || context().parse_constant(&too_deep)).is_err());
     }

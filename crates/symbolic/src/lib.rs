@@ -15,9 +15,7 @@ pub mod monomial;
 pub mod poly;
 
 pub use angle::LinearAngle;
-pub use expr::{
-    ExprContext, ExprError, ExprLimits, MAX_EXPRESSION_DEPTH, MAX_EXPRESSION_LENGTH,
-};
+pub use expr::{ExprContext, ExprError, ExprLimits, MAX_EXPRESSION_DEPTH, MAX_EXPRESSION_LENGTH};
 pub use geometry::{PolyMat3, PolyVec3};
 pub use monomial::{MAX_VARS, Monomial, VarKind};
 pub use poly::{Point, TrigPoly};
