@@ -208,6 +208,15 @@ impl fmt::Display for CaseErrors {
 
 impl std::error::Error for CaseErrors {}
 
+impl<'a> IntoIterator for &'a CaseErrors {
+    type Item = &'a ModelError;
+    type IntoIter = std::slice::Iter<'a, ModelError>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.errors.iter()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -234,14 +243,5 @@ mod tests {
                 "tasks.grid.M1[2]"
             ]
         );
-    }
-}
-
-impl<'a> IntoIterator for &'a CaseErrors {
-    type Item = &'a ModelError;
-    type IntoIter = std::slice::Iter<'a, ModelError>;
-
-    fn into_iter(self) -> Self::IntoIter {
-        self.errors.iter()
     }
 }

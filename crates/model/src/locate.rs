@@ -178,10 +178,10 @@ fn string_end(b: &[u8], start: usize) -> usize {
 }
 
 fn decode_key(quoted: &str) -> String {
-    if quoted.contains('\\') {
-        if let Ok(key) = serde_json::from_str::<String>(quoted) {
-            return key;
-        }
+    if quoted.contains('\\')
+        && let Ok(key) = serde_json::from_str::<String>(quoted)
+    {
+        return key;
     }
     quoted
         .trim_start_matches('"')

@@ -812,7 +812,7 @@ mod tests {
             Ok(2.0)
         );
         let minus = format!("{}3", "-".repeat(n - 1));
-        let expected = if (n - 1) % 2 == 0 { 3.0 } else { -3.0 };
+        let expected = if (n - 1).is_multiple_of(2) { 3.0 } else { -3.0 };
         assert_eq!(
             on_small_stack(move || context().parse_constant(&minus)),
             Ok(expected)
