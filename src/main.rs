@@ -94,7 +94,7 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     }
-    commands::preflight::set_limits(limits);
+    counterpoise::preflight::set_limits(limits);
     // Expressions are parsed recursively up to the depth limit: give the command a stack sized
     // for it, so that lifting the limit cannot overflow the main thread's stack.
     let worker = std::thread::Builder::new()

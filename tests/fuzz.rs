@@ -1,6 +1,7 @@
 //! Fuzz harness (issue 13): mutations of the shipped cases must load or be refused with errors,
-//! and a loadable one must go through the balance search at Dmax 1 — never a panic, within a
-//! time and memory budget.
+//! and a loadable one must go through everything `check` runs (validation, then the preflight:
+//! variant count, catalogue, paths, the task grid as `evaluate` sees it) and the balance search
+//! at Dmax 1 — never a panic, within a time and memory budget.
 //!
 //! Each case applies up to two mutations, either to the JSON tree (a value replaced by an odd one,
 //! a number rescaled, a member removed, an array element duplicated, a key renamed) or to the text (truncated, a
@@ -14,6 +15,7 @@ use counterpoise::balance::{
     Catalogue, SearchOptions, catalogue_options, mechanism_energy, realization_hints, search,
 };
 use counterpoise::model::Case;
+use counterpoise::preflight;
 use proptest::prelude::*;
 use serde_json::{Value, json};
 
@@ -22,12 +24,25 @@ const BUDGET: Duration = Duration::from_secs(10);
 /// Largest resident memory the whole run may reach.
 const MEMORY_BUDGET_KB: u64 = 1 << 20;
 
+/// The shipped cases, the palletizer's grid coarsened to 3 × 3 × 3 points and 11 samples so
+/// that the task-grid check of a case costs milliseconds (robustness, not accuracy, is tested).
 fn shipped() -> Vec<Value> {
     ["palletizer", "pendulum", "two_link"]
         .iter()
         .map(|name| {
             let path = format!("{}/cases/{name}.json", env!("CARGO_MANIFEST_DIR"));
-            serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+            let mut case: Value =
+                serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+            if let Some(grid) = case
+                .pointer_mut("/tasks/grid")
+                .and_then(Value::as_object_mut)
+            {
+                for axis in grid.values_mut() {
+                    axis[2] = json!(3);
+                }
+                case["tasks"]["samples"] = json!(11);
+            }
+            case
         })
         .collect()
 }
@@ -121,11 +136,16 @@ fn mutate(v: &mut Value, op: u8, which: usize, pick: usize) {
     }
 }
 
-/// Loads the text and, when it is a case with balancing, runs the search at Dmax 1.
+/// Loads the text; a loaded case goes through the preflight of `check` and, with balancing,
+/// the search at Dmax 1.
 fn load_and_search(text: &str) {
     let loaded = Case::from_json_str(text);
+    let problems = loaded
+        .as_ref()
+        .ok()
+        .map(|model| preflight::problems(model).0.len());
     if std::env::var_os("FUZZ_STATS").is_some() {
-        eprintln!("FUZZ loaded={}", loaded.is_ok());
+        eprintln!("FUZZ loaded={} problems={problems:?}", loaded.is_ok());
     }
     if let Ok(model) = loaded
         && model.balancing.is_some()

@@ -7,14 +7,14 @@ use anyhow::Result;
 use counterpoise_model::{Model, PayloadMode};
 use counterpoise_symbolic::VarKind;
 
-use super::preflight::GridReach;
+use counterpoise::preflight::GridReach;
 
 pub fn run(path: &Path) -> Result<ExitCode> {
     let Some(model) = super::load(path)? else {
         return Ok(ExitCode::FAILURE);
     };
     // What `variants`, `evaluate` and `run` would otherwise find only later.
-    let (problems, reach) = super::preflight::problems(&model);
+    let (problems, reach) = counterpoise::preflight::problems(&model);
     if !problems.is_empty() {
         super::print_errors(path, &super::located(path, problems));
         return Ok(ExitCode::FAILURE);

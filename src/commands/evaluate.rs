@@ -24,7 +24,7 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
         bail!("{}: the case has no `tasks` section", path.display());
     };
     if let Err(e) =
-        super::preflight::samples_guard(&model, options.samples.unwrap_or(tasks.samples))
+        counterpoise::preflight::samples_guard(&model, options.samples.unwrap_or(tasks.samples))
     {
         super::print_errors(path, &super::located(path, vec![e]));
         return Ok(ExitCode::FAILURE);

@@ -2,13 +2,13 @@
 
 pub mod check;
 pub mod evaluate;
-pub mod preflight;
 pub mod run;
 pub mod variants;
 
 use std::path::Path;
 
 use anyhow::Result;
+use counterpoise::preflight;
 use counterpoise_model::{Case, CaseErrors, Model, ModelError};
 
 /// Loads a case within the limits in force, or prints every validation error (one per line,
@@ -65,4 +65,25 @@ pub fn report(dir: &Path) -> Result<std::process::ExitCode> {
         println!("wrote {}", f.display());
     }
     Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// The guards of `run`, before its first stage: the variant count and the paths (a path found
+/// unfollowable only at the end would waste the whole run). Prints the problems; returns
+/// whether the run may start.
+pub fn before_run(path: &std::path::Path, model: &Model, dmax_given: bool, dmax: usize) -> bool {
+    let source = if dmax_given {
+        "--dmax"
+    } else {
+        "balancing.dmax"
+    };
+    let mut problems: Vec<ModelError> = preflight::variant_guard(model, dmax, source)
+        .err()
+        .into_iter()
+        .collect();
+    problems.extend(preflight::path_problems(model));
+    if problems.is_empty() {
+        return true;
+    }
+    print_errors(path, &located(path, problems));
+    false
 }

@@ -31,7 +31,7 @@ pub fn run(path: &Path, dmax: Option<usize>, as_json: bool) -> Result<ExitCode> 
     if dmax == 0 {
         bail!("--dmax must be at least 1");
     }
-    if let Err(e) = super::preflight::variant_guard(&model, dmax, source) {
+    if let Err(e) = counterpoise::preflight::variant_guard(&model, dmax, source) {
         super::print_errors(path, &super::located(path, vec![e]));
         return Ok(ExitCode::FAILURE);
     }

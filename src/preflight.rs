@@ -229,27 +229,6 @@ pub fn grid_reach(model: &Model) -> Result<Option<GridReach>, ModelError> {
     }))
 }
 
-/// The guards of `run`, before its first stage: the variant count and the paths (a path found
-/// unfollowable only at the end would waste the whole run). Prints the problems; returns
-/// whether the run may start.
-pub fn before_run(path: &std::path::Path, model: &Model, dmax_given: bool, dmax: usize) -> bool {
-    let source = if dmax_given {
-        "--dmax"
-    } else {
-        "balancing.dmax"
-    };
-    let mut problems: Vec<ModelError> = variant_guard(model, dmax, source)
-        .err()
-        .into_iter()
-        .collect();
-    problems.extend(path_problems(model));
-    if problems.is_empty() {
-        return true;
-    }
-    super::print_errors(path, &super::located(path, problems));
-    false
-}
-
 /// Everything `check` verifies beyond validation: the problems `variants`, `evaluate` and `run`
 /// would otherwise meet later.
 pub fn problems(model: &Model) -> (Vec<ModelError>, Option<GridReach>) {
@@ -302,7 +281,8 @@ mod tests {
             );
         }
         // 35 elements (7 bodies, springs to the base), Dmax 50: every subset, 2^35 − 1.
-        assert_eq!(variant_estimate(35, 50), 2f64.powi(35) - 1.0);
+        let all = 2f64.powi(35) - 1.0;
+        assert!((variant_estimate(35, 50) - all).abs() <= 1e-9 * all);
         assert!(variant_estimate(80_000, 8) > 1e30);
         assert!(variant_estimate(u64::MAX / 2, 1_000) > 1e30);
     }
