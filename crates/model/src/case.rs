@@ -8,7 +8,7 @@
 //! Unknown fields are errors: a misspelt optional field would otherwise be silently ignored,
 //! which is the worst kind of modelling error. [`Case::parse`] reports every one of them (the
 //! nested types ignore them and [`serde_ignored`] lists them) together with every shape error
-//! of every section and list element, each with its line and column; see [`crate::reader`].
+//! of every section and list element, each with its line and column (module `reader`).
 
 use std::fmt;
 use std::marker::PhantomData;
