@@ -4,7 +4,10 @@
 //! This package is the command-line tool and a facade over the stage crates:
 //! [`symbolic`] (trigonometric-polynomial algebra), [`model`] (case format, validation,
 //! kinematics), [`balance`] (exact balancing search), [`dynamics`] (inverse dynamics and
-//! indicators over tasks).
+//! indicators over tasks), and [`preflight`]: the checks `check` runs beyond validation and the
+//! guards of the costly stages.
+
+pub mod preflight;
 
 pub use counterpoise_balance as balance;
 pub use counterpoise_dynamics as dynamics;

@@ -14,6 +14,11 @@ struct Cli {
     /// Worker threads for parallel stages (default: all cores). Results do not depend on it.
     #[arg(long, global = true)]
     jobs: Option<usize>,
+    /// Lift (or lower) a resource limit, e.g. `--limit variants=100000`; repeatable. Names:
+    /// file-bytes, parameters, list-items, expression-length, expression-depth, grid-points,
+    /// samples, task-samples, dmax, variants (defaults in docs/case-format.md, Limits).
+    #[arg(long = "limit", global = true, value_name = "NAME=VALUE")]
+    limits: Vec<String>,
     #[command(subcommand)]
     command: Command,
 }
@@ -80,7 +85,45 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    quiet_broken_pipe();
     let cli = Cli::parse();
+    let mut limits = counterpoise_model::Limits::default();
+    for setting in &cli.limits {
+        if let Err(e) = limits.apply(setting) {
+            eprintln!("error: --limit {setting}: {e}");
+            return ExitCode::from(2);
+        }
+    }
+    counterpoise::preflight::set_limits(limits);
+    // Expressions are parsed recursively up to the depth limit: give the command a stack sized
+    // for it, so that lifting the limit cannot overflow the main thread's stack.
+    let worker = std::thread::Builder::new()
+        .name("counterpoise".into())
+        .stack_size(limits.stack_bytes())
+        .spawn(move || run(cli));
+    match worker.map(|handle| handle.join()) {
+        Ok(Ok(code)) => code,
+        Ok(Err(_)) => ExitCode::from(101),
+        Err(e) => {
+            eprintln!("error: cannot start the worker thread: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Writing to a closed pipe (`counterpoise variants … | head -1`) ends the process quietly, as
+/// for any Unix filter, instead of panicking in `println!`: the default action of SIGPIPE is
+/// restored (Rust ignores it, turning the signal into an error every print would panic on).
+fn quiet_broken_pipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in `main`, before any thread exists; `signal` with SIG_DFL
+    // only resets the disposition of SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+fn run(cli: Cli) -> ExitCode {
     if let Some(jobs) = cli.jobs {
         if jobs == 0 {
             eprintln!("error: --jobs must be at least 1");

@@ -4,16 +4,56 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::Result;
-use counterpoise_model::{Kinematics, Model, PayloadMode};
+use counterpoise_model::{Model, PayloadMode};
 use counterpoise_symbolic::VarKind;
-use nalgebra::DVector;
+
+use counterpoise::preflight::GridReach;
 
 pub fn run(path: &Path) -> Result<ExitCode> {
     let Some(model) = super::load(path)? else {
         return Ok(ExitCode::FAILURE);
     };
+    // What `variants`, `evaluate` and `run` would otherwise find only later.
+    let (problems, reach) = counterpoise::preflight::problems(&model);
+    if !problems.is_empty() {
+        super::print_errors(path, &super::located(path, problems));
+        return Ok(ExitCode::FAILURE);
+    }
     print!("{}", summary(&model));
+    if let Some(reach) = &reach {
+        print!("{}", reachability(&model, reach));
+    }
+    for missing in missing_sections(&model) {
+        println!("note: {missing}");
+    }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The optional sections a command needs but the case lacks.
+fn missing_sections(model: &Model) -> Vec<&'static str> {
+    let mut notes = Vec::new();
+    if model.balancing.is_none() {
+        notes.push("no `balancing` section: `variants` and `run` need one");
+    }
+    if model.tasks.is_none() {
+        notes.push("no `tasks` section: `evaluate` and `run` need one");
+    }
+    notes
+}
+
+/// Longest description `check` prints, in characters.
+const MAX_DESCRIPTION: usize = 400;
+
+/// The description's start, cut at [`MAX_DESCRIPTION`] characters.
+fn clipped(description: &str) -> String {
+    match description.char_indices().nth(MAX_DESCRIPTION) {
+        None => description.to_string(),
+        Some((cut, _)) => format!(
+            "{}… ({} more characters)",
+            &description[..cut],
+            description[cut..].chars().count()
+        ),
+    }
 }
 
 fn coordinate_names(model: &Model) -> (Vec<&str>, Vec<bool>) {
@@ -36,7 +76,7 @@ pub fn summary(model: &Model) -> String {
     };
     line(&mut out, format!("case: {}", model.name));
     if let Some(d) = &model.description {
-        line(&mut out, format!("  {d}"));
+        line(&mut out, format!("  {}", clipped(d)));
     }
     line(
         &mut out,
@@ -136,9 +176,6 @@ pub fn summary(model: &Model) -> String {
         &mut out,
         format!("unbalanced potential energy: V = const {varying} J"),
     );
-    if let Some(tasks) = &model.tasks {
-        out.push_str(&reachability(model, tasks));
-    }
     if let Some(b) = &model.balancing {
         let cw = b.counterweights.as_ref().map_or(0, |c| c.bodies.len());
         let springs = b.springs.as_ref().map_or(0, |s| s.pairs().len());
@@ -163,54 +200,37 @@ pub fn summary(model: &Model) -> String {
     out
 }
 
-/// Solves the chart coordinates at every grid point and reports the coordinate ranges reached.
-fn reachability(model: &Model, tasks: &counterpoise_model::Tasks) -> String {
-    let kinematics = Kinematics::new(model);
-    let points = tasks.grid_points();
-    let mut guess = DVector::from_vec(model.reference_configuration());
-    let mut reached: Vec<(f64, f64)> = vec![(f64::INFINITY, f64::NEG_INFINITY); model.dof()];
-    let mut failures = Vec::new();
-    for (index, u) in points.iter().enumerate() {
-        let target = DVector::from_column_slice(u);
-        // warm start from the previous grid point, then from the reference configuration
-        let solved = kinematics.solve_coordinates(&target, &guess).or_else(|_| {
-            kinematics
-                .solve_coordinates(&target, &DVector::from_vec(model.reference_configuration()))
-        });
-        match solved {
-            Ok(q) => {
-                for (k, r) in reached.iter_mut().enumerate() {
-                    *r = (r.0.min(q[k]), r.1.max(q[k]));
-                }
-                guess = q;
-            }
-            Err(e) => failures.push(format!("    grid point {index} u = {u:?}: {e}")),
-        }
-    }
+/// The task grid as `evaluate` and `run` see it: the tasks they evaluate and those they leave
+/// out, from the same evaluation (without reactions).
+fn reachability(model: &Model, reach: &GridReach) -> String {
+    let tasks = model.tasks.as_ref().expect("a grid reach needs tasks");
     let sizes: Vec<String> = tasks.grid.iter().map(|g| g.n.to_string()).collect();
     let mut out = format!(
-        "task grid: {} = {} points, {} reachable\n",
+        "task grid: {} = {} points, {} reachable; {} tasks, {} evaluable\n",
         sizes.join(" × "),
-        points.len(),
-        points.len() - failures.len()
+        reach.points,
+        reach.reached_points,
+        reach.tasks,
+        reach.evaluable
     );
-    for (c, r) in model.coordinates.iter().zip(&reached) {
-        if r.0.is_finite() {
+    if reach.evaluable < reach.tasks {
+        let reasons: Vec<String> = reach
+            .by_reason
+            .iter()
+            .map(|(k, n)| format!("{k} {n}"))
+            .collect();
+        out.push_str(&format!(
+            "  {} tasks are left out by evaluate and run ({}), e.g.\n",
+            reach.tasks - reach.evaluable,
+            reasons.join(", ")
+        ));
+        let points = tasks.grid_points();
+        for (i, j, reason) in &reach.examples {
             out.push_str(&format!(
-                "  {:<10} reached [{:.6}, {:.6}] {}\n",
-                c.name,
-                r.0,
-                r.1,
-                c.unit()
+                "    task {i}→{j} (u = {:?} → {:?}): {reason}\n",
+                points[*i], points[*j]
             ));
         }
-    }
-    for f in failures.iter().take(10) {
-        out.push_str(f);
-        out.push('\n');
-    }
-    if failures.len() > 10 {
-        out.push_str(&format!("    … and {} more\n", failures.len() - 10));
     }
     out
 }

@@ -20,8 +20,14 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     let Some(model) = super::load(path)? else {
         return Ok(ExitCode::FAILURE);
     };
-    if model.tasks.is_none() {
+    let Some(tasks) = &model.tasks else {
         bail!("{}: the case has no `tasks` section", path.display());
+    };
+    if let Err(e) =
+        counterpoise::preflight::samples_guard(&model, options.samples.unwrap_or(tasks.samples))
+    {
+        super::print_errors(path, &super::located(path, vec![e]));
+        return Ok(ExitCode::FAILURE);
     }
     if let Some(((i, j), file)) = options.series {
         let series =

@@ -8,21 +8,33 @@ pub mod variants;
 use std::path::Path;
 
 use anyhow::Result;
-use counterpoise_model::{Case, Model};
+use counterpoise::preflight;
+use counterpoise_model::{Case, CaseErrors, Model, ModelError};
 
-/// Loads a case, or prints every validation error (one per line, each naming its JSON path) and
-/// returns `None`.
+/// Loads a case within the limits in force, or prints every validation error (one per line,
+/// each naming its JSON path, line and column) and returns `None`.
 pub fn load(path: &Path) -> Result<Option<Model>> {
-    match Case::from_path(path) {
+    match Case::from_path_with(path, preflight::limits()) {
         Ok(model) => Ok(Some(model)),
         Err(errors) => {
-            eprintln!("{}: {} error(s)", path.display(), errors.len());
-            for e in &errors {
-                eprintln!("  {e}");
-            }
+            print_errors(path, &errors);
             Ok(None)
         }
     }
+}
+
+/// Prints errors found in a case file to stderr.
+pub fn print_errors(path: &Path, errors: &CaseErrors) {
+    eprintln!("{}: {} error(s)", path.display(), errors.len());
+    for line in errors.lines() {
+        eprintln!("  {line}");
+    }
+}
+
+/// Errors found after loading (by [`preflight`]), sorted and located in the file's text.
+pub fn located(path: &Path, errors: Vec<ModelError>) -> CaseErrors {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    CaseErrors::sorted_and_located(errors, &text)
 }
 
 /// Writes a file atomically: a temporary file in the same directory, flushed, then renamed over
@@ -53,4 +65,25 @@ pub fn report(dir: &Path) -> Result<std::process::ExitCode> {
         println!("wrote {}", f.display());
     }
     Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// The guards of `run`, before its first stage: the variant count and the paths (a path found
+/// unfollowable only at the end would waste the whole run). Prints the problems; returns
+/// whether the run may start.
+pub fn before_run(path: &std::path::Path, model: &Model, dmax_given: bool, dmax: usize) -> bool {
+    let source = if dmax_given {
+        "--dmax"
+    } else {
+        "balancing.dmax"
+    };
+    let mut problems: Vec<ModelError> = preflight::variant_guard(model, dmax, source)
+        .err()
+        .into_iter()
+        .collect();
+    problems.extend(preflight::path_problems(model));
+    if problems.is_empty() {
+        return true;
+    }
+    print_errors(path, &located(path, problems));
+    false
 }

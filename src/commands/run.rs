@@ -73,6 +73,9 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     if dmax == 0 {
         bail!("--dmax must be at least 1");
     }
+    if !super::before_run(path, &model, options.dmax.is_some(), dmax) {
+        return Ok(ExitCode::FAILURE);
+    }
     let out_dir = options
         .out
         .clone()

@@ -22,9 +22,18 @@ pub fn run(path: &Path, dmax: Option<usize>, as_json: bool) -> Result<ExitCode> 
     let Some(balancing) = &model.balancing else {
         bail!("{}: the case has no `balancing` section", path.display());
     };
+    let source = if dmax.is_some() {
+        "--dmax"
+    } else {
+        "balancing.dmax"
+    };
     let dmax = dmax.unwrap_or(balancing.dmax);
     if dmax == 0 {
         bail!("--dmax must be at least 1");
+    }
+    if let Err(e) = counterpoise::preflight::variant_guard(&model, dmax, source) {
+        super::print_errors(path, &super::located(path, vec![e]));
+        return Ok(ExitCode::FAILURE);
     }
     let started = Instant::now();
     let energy = mechanism_energy(&model);

@@ -236,12 +236,13 @@ pub fn find_witness(
 /// The first mass or stiffness of the witness below its floor, described.
 fn below_floor(witness: &Witness, hints: RealizationHints) -> Option<String> {
     for cw in &witness.counterweights {
-        if !(cw.mass >= hints.mass_floor()) {
+        // NaN fails too.
+        if cw.mass.is_nan() || cw.mass < hints.mass_floor() {
             return Some(format!("a mass of {:.3e} kg", cw.mass));
         }
     }
     for spring in &witness.springs {
-        if !(spring.stiffness >= hints.stiffness_floor()) {
+        if spring.stiffness.is_nan() || spring.stiffness < hints.stiffness_floor() {
             return Some(format!("a stiffness of {:.3e} N/m", spring.stiffness));
         }
     }

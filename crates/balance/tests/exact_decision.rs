@@ -198,36 +198,30 @@ fn one_ulp_changes_of_inputs_keep_every_verdict() {
         .iter()
         .map(|v| (labels(v), v.status))
         .collect();
+    // One ulp away from zero for each non-zero decimal: lengths, masses, a centre of mass,
+    // gravity.
     let next_up = |x: f64| f64::from_bits(x.to_bits() + 1);
-    let mut edits: Vec<Box<dyn Fn(&mut serde_json::Value)>> = Vec::new();
-    for p in ["d1", "d2", "d3", "d4"] {
-        edits.push(Box::new(move |c: &mut serde_json::Value| {
-            let x = c["parameters"][p].as_f64().unwrap();
-            c["parameters"][p] = serde_json::json!(next_up(x));
-        }));
-    }
-    for b in [0, 3, 6] {
-        edits.push(Box::new(move |c: &mut serde_json::Value| {
-            let x = c["bodies"][b]["mass"].as_f64().unwrap();
-            c["bodies"][b]["mass"] = serde_json::json!(next_up(x));
-        }));
-    }
-    edits.push(Box::new(|c: &mut serde_json::Value| {
-        let x = c["bodies"][3]["com"][0].as_f64().unwrap();
-        c["bodies"][3]["com"][0] = serde_json::json!(next_up(x));
-    }));
-    edits.push(Box::new(|c: &mut serde_json::Value| {
-        c["gravity"][1] = serde_json::json!(next_up(-9.81));
-    }));
-    for edit in edits {
+    let inputs = [
+        "/parameters/d1",
+        "/parameters/d2",
+        "/parameters/d3",
+        "/parameters/d4",
+        "/bodies/0/mass",
+        "/bodies/3/mass",
+        "/bodies/6/mass",
+        "/bodies/3/com/0",
+        "/gravity/1",
+    ];
+    for pointer in inputs {
         let mut case = base.clone();
-        edit(&mut case);
+        let value = case.pointer_mut(pointer).expect("the input exists");
+        *value = serde_json::json!(next_up(value.as_f64().unwrap()));
         let verdicts: Vec<(Vec<String>, Status)> = run(&model_of(&case), 2)
             .variants
             .iter()
             .map(|v| (labels(v), v.status))
             .collect();
-        assert_eq!(verdicts, reference);
+        assert_eq!(verdicts, reference, "{pointer}");
     }
 }
 

@@ -46,11 +46,20 @@ impl TaskSet {
                 tasks.duration
             )));
         }
-        let points = tasks.grid_points();
-        let n = points.len();
-        if n > u32::MAX as usize {
-            return Err(DynamicsError::BadGrid("too many grid points".into()));
+        // The size is checked before the grid is built: a model made without validation could
+        // ask for 1e30 points.
+        let n = tasks
+            .grid
+            .iter()
+            .try_fold(1usize, |acc, axis| acc.checked_mul(axis.n))
+            .filter(|&n| n <= u32::MAX as usize)
+            .ok_or_else(|| DynamicsError::BadGrid("too many grid points".into()))?;
+        if n < 2 {
+            return Err(DynamicsError::BadGrid(
+                "the grid has a single point, so there is no move between two points".into(),
+            ));
         }
+        let points = tasks.grid_points();
         let mut pairs = Vec::new();
         match tasks.pairs {
             PairMode::All => {
@@ -154,6 +163,20 @@ mod tests {
             let (i, j) = ordered.pair(t);
             assert_eq!(ordered.index_of(i, j), Some(t));
         }
+    }
+
+    #[test]
+    fn a_single_point_or_an_overflowing_grid_is_an_error_not_a_panic() {
+        let mut single = tasks(PairMode::All);
+        for axis in &mut single.grid {
+            axis.n = 1;
+        }
+        let err = TaskSet::new(&single, None).unwrap_err();
+        assert!(err.to_string().contains("single point"), "{err}");
+        let mut huge = tasks(PairMode::Ordered);
+        huge.grid[0].n = usize::MAX / 2;
+        huge.grid[1].n = 3;
+        assert!(TaskSet::new(&huge, None).is_err());
     }
 
     #[test]

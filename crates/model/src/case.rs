@@ -5,8 +5,10 @@
 //! [`crate::validate`], which turns a [`Case`] into a [`crate::Model`]. Keeping the raw form
 //! separate lets a results file echo the case exactly as the designer wrote it.
 //!
-//! Every struct denies unknown fields: a misspelt optional field would otherwise be silently
-//! ignored, which is the worst kind of modelling error.
+//! Unknown fields are errors: a misspelt optional field would otherwise be silently ignored,
+//! which is the worst kind of modelling error. [`Case::parse`] reports every one of them (the
+//! nested types ignore them and [`serde_ignored`] lists them) together with every shape error
+//! of every section and list element, each with its line and column (module `reader`).
 
 use std::fmt;
 use std::marker::PhantomData;
@@ -14,8 +16,6 @@ use std::marker::PhantomData;
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::ser::{SerializeMap, Serializer};
 use serde::{Deserialize, Serialize};
-
-use crate::error::{CaseErrors, ModelError};
 
 /// A case-language expression: a string such as `"d2 + d1*sin(th2)"`, or a plain number.
 #[derive(Clone, Debug, PartialEq)]
@@ -132,8 +132,9 @@ impl<'de, V: Deserialize<'de>> Deserialize<'de> for NamedMap<V> {
             }
             fn visit_map<A: MapAccess<'de>>(self, mut access: A) -> Result<Self::Value, A::Error> {
                 let mut entries: Vec<(String, V)> = Vec::new();
+                let mut seen = std::collections::HashSet::new();
                 while let Some(key) = access.next_key::<String>()? {
-                    if entries.iter().any(|(k, _)| *k == key) {
+                    if !seen.insert(key.clone()) {
                         // Fail inside the value so that the error's path ends with the key.
                         access.next_value_seed(Duplicate(key))?;
                         unreachable!("a duplicate key always fails");
@@ -237,7 +238,6 @@ pub enum CoordinateKindSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct CoordinateSpec {
     pub name: String,
     pub kind: CoordinateKindSpec,
@@ -246,7 +246,7 @@ pub struct CoordinateSpec {
 
 /// One step of a body pose; the steps of a body are composed left to right.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
+#[serde(rename_all = "snake_case")]
 pub enum PoseStep {
     Translate([Expr; 3]),
     RotX(Expr),
@@ -257,7 +257,6 @@ pub enum PoseStep {
 
 /// Standard Denavit–Hartenberg parameters: `Rz(theta)·Tz(d)·Tx(a)·Rx(alpha)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct DhStep {
     pub d: Expr,
     pub theta: Expr,
@@ -266,7 +265,6 @@ pub struct DhStep {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct BodySpec {
     pub name: String,
     /// Reference frame of the pose: `"base"` or another body.
@@ -281,7 +279,6 @@ pub struct BodySpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct PayloadSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
@@ -306,7 +303,6 @@ pub enum JointKindSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct JointSpec {
     pub name: String,
     pub kind: JointKindSpec,
@@ -320,7 +316,6 @@ pub struct JointSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct ActuatorSpec {
     pub name: String,
     pub joint: String,
@@ -337,7 +332,6 @@ pub enum PlaneSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct BalancingSpec {
     pub dmax: u32,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -354,7 +348,6 @@ pub struct BalancingSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct CounterweightSpec {
     pub bodies: Selection,
     #[serde(default)]
@@ -364,20 +357,18 @@ pub struct CounterweightSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
+#[serde(rename_all = "snake_case")]
 pub enum ShapeSpec {
     Cylinder(CylinderSpec),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct CylinderSpec {
     pub radius_to_thickness: f64,
     pub density: f64,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct SpringSpec {
     pub bodies: Selection,
     #[serde(default)]
@@ -387,7 +378,6 @@ pub struct SpringSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct BoundsSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mass: Option<[f64; 2]>,
@@ -421,7 +411,6 @@ fn default_samples() -> u32 {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct TasksSpec {
     /// Actuator name → `[from, to, n]`.
     pub grid: NamedMap<[f64; 3]>,
@@ -435,7 +424,6 @@ pub struct TasksSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct PathSpec {
     pub name: String,
     /// Waypoint name → actuator values in actuator order.
@@ -447,7 +435,6 @@ pub struct PathSpec {
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct PathPayloadSpec {
     pub body: String,
     pub mass: f64,
@@ -456,37 +443,4 @@ pub struct PathPayloadSpec {
     pub inertia: Option<[f64; 6]>,
     pub pick_at: String,
     pub drop_at: String,
-}
-
-impl Case {
-    /// Parses the JSON text of a case file without validating its meaning.
-    ///
-    /// A shape error names both the JSON path (`bodies[2].mass`) and the line and column.
-    pub fn parse(text: &str) -> Result<Case, CaseErrors> {
-        let mut deserializer = serde_json::Deserializer::from_str(text);
-        let case: Case = serde_path_to_error::deserialize(&mut deserializer).map_err(|e| {
-            let path = e.path().to_string();
-            let inner = e.into_inner();
-            syntax_error(path, &inner)
-        })?;
-        deserializer
-            .end()
-            .map_err(|e| syntax_error(".".to_string(), &e))?;
-        Ok(case)
-    }
-}
-
-fn syntax_error(path: String, error: &serde_json::Error) -> ModelError {
-    // serde_json appends " at line L column C" to its message; we report those separately.
-    let message = error.to_string();
-    let message = match message.rfind(" at line ") {
-        Some(i) => message[..i].to_string(),
-        None => message,
-    };
-    ModelError::Syntax {
-        path,
-        line: error.line(),
-        column: error.column(),
-        message,
-    }
 }

@@ -9,6 +9,8 @@ use std::fmt;
 
 use counterpoise_symbolic::ExprError;
 
+pub use crate::locate::Position;
+
 /// One problem found in a case file.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ModelError {
@@ -77,7 +79,8 @@ impl ModelError {
         }
     }
 
-    pub(crate) fn invalid(path: impl Into<String>, reason: impl Into<String>) -> ModelError {
+    /// A value out of its domain at `path`.
+    pub fn invalid(path: impl Into<String>, reason: impl Into<String>) -> ModelError {
         ModelError::Invalid {
             path: path.into(),
             reason: reason.into(),
@@ -85,13 +88,63 @@ impl ModelError {
     }
 }
 
-/// All problems found in one case file (never empty).
+/// All problems found in one case file (never empty), sorted by path.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CaseErrors {
     pub errors: Vec<ModelError>,
+    /// Where each error's field is in the text (same order as `errors`; `None` when the errors
+    /// were not produced from a text). [`ModelError::Syntax`] carries its own.
+    pub positions: Vec<Option<Position>>,
 }
 
 impl CaseErrors {
+    /// Errors without positions, in the given order.
+    pub fn new(errors: Vec<ModelError>) -> CaseErrors {
+        let positions = vec![None; errors.len()];
+        CaseErrors { errors, positions }
+    }
+
+    /// Sorts the errors by path (array indices numerically; a stable sort keeps the order of
+    /// errors on the same field) and locates each in `text`, the case file's text.
+    pub fn sorted_and_located(mut errors: Vec<ModelError>, text: &str) -> CaseErrors {
+        errors.sort_by_cached_key(|e| path_key(e.path()));
+        let paths: Vec<&str> = errors.iter().map(ModelError::path).collect();
+        let found = crate::locate::positions(text, &paths);
+        let positions = errors
+            .iter()
+            .map(|e| match e {
+                ModelError::Syntax { line, column, .. } if *line > 0 => Some(Position {
+                    line: *line,
+                    column: *column,
+                }),
+                // A command-line option (`--dmax`) is not in the file.
+                _ if e.path().starts_with("--") => None,
+                _ => found.get(e.path()).copied(),
+            })
+            .collect();
+        CaseErrors { errors, positions }
+    }
+
+    /// Each error with its position.
+    pub fn located(&self) -> impl Iterator<Item = (&ModelError, Option<Position>)> {
+        self.errors.iter().zip(
+            self.positions
+                .iter()
+                .copied()
+                .chain(std::iter::repeat(None)),
+        )
+    }
+
+    /// One line per error: the error, then its line and column where the text has them.
+    pub fn lines(&self) -> Vec<String> {
+        self.located()
+            .map(|(e, at)| match (e, at) {
+                (ModelError::Syntax { .. }, _) | (_, None) => e.to_string(),
+                (_, Some(at)) => format!("{e} (line {}, column {})", at.line, at.column),
+            })
+            .collect()
+    }
+
     pub fn iter(&self) -> impl Iterator<Item = &ModelError> {
         self.errors.iter()
     }
@@ -107,10 +160,35 @@ impl CaseErrors {
 
 impl From<ModelError> for CaseErrors {
     fn from(error: ModelError) -> Self {
-        CaseErrors {
-            errors: vec![error],
+        CaseErrors::new(vec![error])
+    }
+}
+
+/// One segment of a path, ordered so that `bodies[2]` comes before `bodies[10]`.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Segment {
+    Index(u64),
+    Name(String),
+}
+
+fn path_key(path: &str) -> Vec<Segment> {
+    let mut key = Vec::new();
+    for part in path.split('.').filter(|p| !p.is_empty()) {
+        let mut pieces = part.split('[');
+        if let Some(name) = pieces.next()
+            && !name.is_empty()
+        {
+            key.push(Segment::Name(name.to_string()));
+        }
+        for index in pieces {
+            let digits = index.trim_end_matches(']');
+            key.push(match digits.parse() {
+                Ok(n) => Segment::Index(n),
+                Err(_) => Segment::Name(digits.to_string()),
+            });
         }
     }
+    key
 }
 
 impl fmt::Display for CaseErrors {
@@ -121,8 +199,8 @@ impl fmt::Display for CaseErrors {
             "{n} error{} in the case file",
             if n == 1 { "" } else { "s" }
         )?;
-        for error in &self.errors {
-            write!(f, "\n  {error}")?;
+        for line in self.lines() {
+            write!(f, "\n  {line}")?;
         }
         Ok(())
     }
@@ -136,5 +214,34 @@ impl<'a> IntoIterator for &'a CaseErrors {
 
     fn into_iter(self) -> Self::IntoIter {
         self.errors.iter()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_sort_naturally() {
+        let mut paths = vec![
+            "tasks.grid.M1[2]",
+            "bodies[10].mass",
+            "bodies[2].pose[0].rot_z",
+            ".",
+            "bodies[2].mass",
+            "actuators",
+        ];
+        paths.sort_by_key(|p| path_key(p));
+        assert_eq!(
+            paths,
+            vec![
+                ".",
+                "actuators",
+                "bodies[2].mass",
+                "bodies[2].pose[0].rot_z",
+                "bodies[10].mass",
+                "tasks.grid.M1[2]"
+            ]
+        );
     }
 }

@@ -15,18 +15,22 @@ pub mod error;
 pub mod exact;
 mod joints;
 pub mod kinematics;
+pub mod limits;
+mod locate;
 pub mod model;
 pub mod newton;
 mod pose;
+mod reader;
 pub mod sampling;
 pub mod validate;
 
 use std::path::Path;
 
 pub use case::Case;
-pub use error::{CaseErrors, ModelError};
+pub use error::{CaseErrors, ModelError, Position};
 pub use exact::{ExactFrame, ExactMechanism, NotExact, exact_mechanism};
 pub use kinematics::{BodyJacobian, BodyMotion, Kinematics, Pose};
+pub use limits::{Limit, Limits};
 pub use model::{
     Actuator, ActuatorMap, Balancing, Body, BodyId, Bounds, Coordinate, CounterweightOptions,
     CounterweightShape, GridAxis, Joint, JointKind, Model, MotionLaw, PairMode, PathPayload,
@@ -35,18 +39,44 @@ pub use model::{
 pub use newton::{KinematicsError, NewtonOptions};
 
 impl Case {
-    /// Parses and validates a case from JSON text.
+    /// Parses and validates a case from JSON text, with the default [`Limits`].
     pub fn from_json_str(text: &str) -> Result<Model, CaseErrors> {
-        validate::validate(Case::parse(text)?)
+        Case::from_json_str_with(text, &Limits::default())
     }
 
-    /// Reads, parses and validates a case file.
+    /// Parses and validates a case from JSON text: every error found (unknown fields, bad
+    /// values, bad references), sorted by path and located in the text.
+    pub fn from_json_str_with(text: &str, limits: &Limits) -> Result<Model, CaseErrors> {
+        let (case, mut errors) = reader::parse(text, limits);
+        if let Some(case) = case {
+            match validate::validate_with(case, limits) {
+                Ok(model) if errors.is_empty() => return Ok(model),
+                Ok(_) => {}
+                Err(e) => errors.extend(e.errors),
+            }
+        }
+        Err(CaseErrors::sorted_and_located(errors, text))
+    }
+
+    /// Reads, parses and validates a case file, with the default [`Limits`].
     pub fn from_path(path: &Path) -> Result<Model, CaseErrors> {
-        let text = std::fs::read_to_string(path).map_err(|e| ModelError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
-        Case::from_json_str(&text)
+        Case::from_path_with(path, &Limits::default())
+    }
+
+    /// Reads, parses and validates a case file; a file over the size limit is refused before
+    /// it is read.
+    pub fn from_path_with(path: &Path, limits: &Limits) -> Result<Model, CaseErrors> {
+        let text = reader::read_text(path, limits)?;
+        Case::from_json_str_with(&text, limits)
+    }
+
+    /// Parses the JSON text of a case file without validating its meaning. Every shape error
+    /// is reported, each with its JSON path, line and column.
+    pub fn parse(text: &str) -> Result<Case, CaseErrors> {
+        match reader::parse(text, &Limits::default()) {
+            (Some(case), errors) if errors.is_empty() => Ok(case),
+            (_, errors) => Err(CaseErrors::sorted_and_located(errors, text)),
+        }
     }
 
     /// Validates an already parsed case.

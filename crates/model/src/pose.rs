@@ -8,6 +8,7 @@ use counterpoise_symbolic::{Context, Field, Mat3, Poly, TrigPoly, Vec3};
 
 use crate::case::{Expr, PoseStep};
 use crate::error::ModelError;
+use crate::limits::MAX_POSE_DEGREE;
 
 /// A rigid transform `x ↦ R x + p` with polynomial entries over the field `C`.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,14 +28,41 @@ impl<C: Field> SymbolicPose<C> {
         }
     }
 
-    /// `self · (translation t)`.
-    fn translate(&mut self, t: &Vec3<C>) {
-        self.origin = self.origin.add(&self.rotation.mul_vec(t));
+    /// Highest power of one coordinate in the pose (rotation and origin).
+    pub fn degree(&self) -> u32 {
+        let rotation = self.rotation.0.iter().flatten().map(Poly::max_power);
+        let origin = self.origin.0.iter().map(Poly::max_power);
+        rotation.chain(origin).max().unwrap_or(0)
     }
 
-    /// `self · (rotation r)`.
-    fn rotate(&mut self, r: &Mat3<C>) {
+    /// `self · (translation t)`, refused when the product would pass [`MAX_POSE_DEGREE`] (the
+    /// symbolic core stores powers in a byte: an unchecked product could overflow it).
+    fn translate(&mut self, t: &Vec3<C>, path: &str) -> Result<(), ModelError> {
+        let step = t.0.iter().map(Poly::max_power).max().unwrap_or(0);
+        self.check_degree(step, path)?;
+        self.origin = self.origin.add(&self.rotation.mul_vec(t));
+        Ok(())
+    }
+
+    /// `self · (rotation r)`, refused like [`SymbolicPose::translate`].
+    fn rotate(&mut self, r: &Mat3<C>, path: &str) -> Result<(), ModelError> {
+        let step = r.0.iter().flatten().map(Poly::max_power).max().unwrap_or(0);
+        self.check_degree(step, path)?;
         self.rotation = self.rotation.mul_mat(r);
+        Ok(())
+    }
+
+    fn check_degree(&self, step: u32, path: &str) -> Result<(), ModelError> {
+        let degree = self.degree() + step;
+        if degree > MAX_POSE_DEGREE {
+            return Err(ModelError::invalid(
+                path,
+                format!(
+                    "the pose reaches degree {degree} in one coordinate; at most {MAX_POSE_DEGREE} is supported"
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// `self · other`.
@@ -178,8 +206,15 @@ impl<F: Field> Parser<'_, F> {
         for (n, step) in steps.iter().enumerate() {
             let step_path = format!("{path}[{n}]");
             if let Err(e) = self.apply_step(&mut pose, step, &step_path) {
+                // Past the degree limit every further step fails the same way: report it once.
+                let degree = e
+                    .iter()
+                    .any(|e| e.to_string().contains("pose reaches degree"));
                 errors.extend(e);
                 ok = false;
+                if degree {
+                    break;
+                }
             }
         }
         ok.then_some(pose)
@@ -204,25 +239,28 @@ impl<F: Field> Parser<'_, F> {
                 if !errors.is_empty() {
                     return Err(errors);
                 }
-                pose.translate(&Vec3(entries));
+                pose.translate(&Vec3(entries), path).map_err(|e| vec![e])?;
             }
             PoseStep::RotX(e) => {
                 let (c, s) = self
                     .cos_sin(e, &format!("{path}.rot_x"))
                     .map_err(|e| vec![e])?;
-                pose.rotate(&Mat3::rot_x_cs(c, s));
+                pose.rotate(&Mat3::rot_x_cs(c, s), path)
+                    .map_err(|e| vec![e])?;
             }
             PoseStep::RotY(e) => {
                 let (c, s) = self
                     .cos_sin(e, &format!("{path}.rot_y"))
                     .map_err(|e| vec![e])?;
-                pose.rotate(&Mat3::rot_y_cs(c, s));
+                pose.rotate(&Mat3::rot_y_cs(c, s), path)
+                    .map_err(|e| vec![e])?;
             }
             PoseStep::RotZ(e) => {
                 let (c, s) = self
                     .cos_sin(e, &format!("{path}.rot_z"))
                     .map_err(|e| vec![e])?;
-                pose.rotate(&Mat3::rot_z_cs(c, s));
+                pose.rotate(&Mat3::rot_z_cs(c, s), path)
+                    .map_err(|e| vec![e])?;
             }
             PoseStep::Dh(dh) => {
                 let theta = self.cos_sin(&dh.theta, &format!("{path}.dh.theta"));
@@ -232,9 +270,11 @@ impl<F: Field> Parser<'_, F> {
                 match (theta, d, a, alpha) {
                     (Ok((ct, st)), Ok(d), Ok(a), Ok((ca, sa))) => {
                         // Rz(theta)·Tz(d)·Tx(a)·Rx(alpha)
-                        pose.rotate(&Mat3::rot_z_cs(ct, st));
-                        pose.translate(&Vec3([a, Poly::zero(), d]));
-                        pose.rotate(&Mat3::rot_x_cs(ca, sa));
+                        let steps = pose
+                            .rotate(&Mat3::rot_z_cs(ct, st), path)
+                            .and_then(|()| pose.translate(&Vec3([a, Poly::zero(), d]), path))
+                            .and_then(|()| pose.rotate(&Mat3::rot_x_cs(ca, sa), path));
+                        steps.map_err(|e| vec![e])?;
                     }
                     (theta, d, a, alpha) => {
                         let mut errors = Vec::new();

@@ -15,12 +15,14 @@ use crate::case::{
 };
 use crate::error::{CaseErrors, ModelError};
 use crate::joints::{self, JointInput};
+use crate::limits::{Limit, Limits, MAX_POSE_DEGREE};
 use crate::model::{
     Actuator, ActuatorMap, Balancing, Body, BodyId, Bounds, Coordinate, CounterweightOptions,
     CounterweightShape, GridAxis, Joint, JointKind, Model, MotionLaw, PairMode, PathPayload,
     Payload, Plane, SpringOptions, TaskPath, Tasks, Waypoint,
 };
 use crate::pose::{Parser, PolyPose};
+use crate::reader::too_large;
 use crate::sampling::{DEFAULT_SEED, VALIDATION_SAMPLES, sample_configurations};
 
 /// Relative tolerance of the joint checks: deviations up to `JOINT_TOLERANCE · (1 + L)` pass,
@@ -29,6 +31,41 @@ pub const JOINT_TOLERANCE: f64 = 1e-9;
 
 /// Relative tolerance of the check that an actuated coordinate moves like its joint.
 pub const ACTUATOR_TOLERANCE: f64 = 1e-8;
+
+/// Largest length a case may give (coordinate ranges, centres of mass, joint points, pose
+/// translations, element bounds), m. Bounds like these keep the numerics (SVD, Newton, the
+/// dynamics) well conditioned: a link of 1e308 m would otherwise spin in an SVD for minutes.
+pub const MAX_LENGTH: f64 = 1e3;
+/// Largest angle of a coordinate range, rad.
+pub const MAX_ANGLE: f64 = 1e3;
+/// Largest mass (bodies, payloads, counterweight bounds), kg.
+pub const MAX_MASS: f64 = 1e6;
+/// Largest inertia tensor entry, kg·m².
+pub const MAX_INERTIA: f64 = 1e6;
+/// Largest gravity component, m/s².
+pub const MAX_GRAVITY: f64 = 1e3;
+/// Largest parameter value (parameters are plain numbers; what they become is bounded where
+/// they are used).
+pub const MAX_PARAMETER: f64 = 1e9;
+/// Largest actuator ratio, peak torque limit (N·m), spring stiffness bound (N/m) and
+/// counterweight density (kg/m³).
+pub const MAX_RATIO: f64 = 1e6;
+pub const MAX_TORQUE: f64 = 1e9;
+pub const MAX_STIFFNESS: f64 = 1e9;
+pub const MAX_DENSITY: f64 = 1e6;
+/// Move and segment durations, s: shorter moves make accelerations overflow, longer ones are
+/// not tasks.
+pub const DURATION_RANGE: [f64; 2] = [1e-3, 1e6];
+
+/// A number for a message: plain when moderate, in exponent form when huge or tiny (`1e308`
+/// is not printed as 309 digits).
+fn num(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e9).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
 
 /// Names the expression language reserves.
 const RESERVED: [&str; 3] = ["pi", "cos", "sin"];
@@ -41,9 +78,77 @@ fn is_identifier(name: &str) -> bool {
 
 struct Validator {
     errors: Vec<ModelError>,
+    limits: Limits,
 }
 
 impl Validator {
+    /// Checks `|value| ≤ max` (the value is already known finite or reported).
+    fn magnitude(&mut self, value: f64, max: f64, path: &str, unit: &str) -> bool {
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        if value.abs() > max {
+            self.invalid(
+                path,
+                format!(
+                    "{}{unit} is beyond the supported magnitude ±{}{unit}",
+                    num(value),
+                    num(max)
+                ),
+            );
+            return false;
+        }
+        true
+    }
+
+    /// Every entry finite and within `±max`.
+    fn bounded(&mut self, values: &[f64], max: f64, path: &str, unit: &str) -> bool {
+        let mut ok = true;
+        for (k, &v) in values.iter().enumerate() {
+            let item = format!("{path}[{k}]");
+            if !v.is_finite() {
+                self.invalid(item, format!("{v} is not a finite number"));
+                ok = false;
+            } else {
+                ok &= self.magnitude(v, max, &item, unit);
+            }
+        }
+        ok
+    }
+
+    /// A duration within [`DURATION_RANGE`].
+    fn duration(&mut self, value: f64, path: &str) -> bool {
+        let [lo, hi] = DURATION_RANGE;
+        if !(value.is_finite() && (lo..=hi).contains(&value)) {
+            self.invalid(
+                path,
+                format!(
+                    "must be a duration between {lo} and {hi} s (found {})",
+                    num(value)
+                ),
+            );
+            return false;
+        }
+        true
+    }
+
+    /// A list no longer than the list limit.
+    fn list_size(&mut self, len: usize, path: &str) -> bool {
+        if len as u64 > self.limits.list_items {
+            self.push(too_large(
+                path,
+                "entries",
+                len as f64,
+                Limit::ListItems,
+                self.limits.list_items,
+            ));
+            return false;
+        }
+        true
+    }
+
     fn push(&mut self, error: ModelError) {
         self.errors.push(error);
     }
@@ -104,23 +209,45 @@ impl Validator {
 
     fn positive(&mut self, value: f64, path: &str) -> bool {
         if !(value.is_finite() && value > 0.0) {
-            self.invalid(path, format!("must be a finite number > 0 (found {value})"));
+            self.invalid(
+                path,
+                format!("must be a finite number > 0 (found {})", num(value)),
+            );
             return false;
         }
         true
+    }
+
+    /// `0 < value ≤ max`.
+    fn positive_at_most(&mut self, value: f64, max: f64, path: &str, unit: &str) -> bool {
+        self.positive(value, path) && self.magnitude(value, max, path, unit)
     }
 
     fn non_negative(&mut self, value: f64, path: &str) -> bool {
         if !(value.is_finite() && value >= 0.0) {
-            self.invalid(path, format!("must be a finite number ≥ 0 (found {value})"));
+            self.invalid(
+                path,
+                format!("must be a finite number ≥ 0 (found {})", num(value)),
+            );
             return false;
         }
         true
     }
 
+    /// `0 ≤ value ≤ max`.
+    fn non_negative_at_most(&mut self, value: f64, max: f64, path: &str, unit: &str) -> bool {
+        self.non_negative(value, path) && self.magnitude(value, max, path, unit)
+    }
+
+    /// A constant vector of lengths within [`MAX_LENGTH`].
+    fn length_vec(&mut self, value: Option<[f64; 3]>, path: &str) -> Option<[f64; 3]> {
+        let value = value?;
+        self.bounded(&value, MAX_LENGTH, path, "m").then_some(value)
+    }
+
     /// The inertia tensor from `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]`, checked positive semi-definite.
     fn inertia(&mut self, v: &[f64; 6], path: &str) -> Option<Matrix3<f64>> {
-        if !self.finite(v, path) {
+        if !self.bounded(v, MAX_INERTIA, path, "kg·m²") {
             return None;
         }
         let [ixx, iyy, izz, ixy, ixz, iyz] = *v;
@@ -152,8 +279,8 @@ impl Validator {
         Some(v.normalize())
     }
 
-    fn interval(&mut self, v: [f64; 2], path: &str) -> Option<[f64; 2]> {
-        if !self.finite(&v, path) {
+    fn interval(&mut self, v: [f64; 2], max: f64, unit: &str, path: &str) -> Option<[f64; 2]> {
+        if !self.bounded(&v, max, path, unit) {
             return None;
         }
         if v[0] < 0.0 || v[0] > v[1] {
@@ -170,12 +297,31 @@ impl Validator {
     }
 }
 
-/// Validates a parsed case into a model, reporting every problem found.
+/// Validates a parsed case into a model with the default [`Limits`], reporting every problem
+/// found.
 pub fn validate(case: Case) -> Result<Model, CaseErrors> {
-    let mut v = Validator { errors: Vec::new() };
+    validate_with(case, &Limits::default())
+}
+
+/// Validates a parsed case into a model, reporting every problem found.
+pub fn validate_with(case: Case, limits: &Limits) -> Result<Model, CaseErrors> {
+    let mut v = Validator {
+        errors: Vec::new(),
+        limits: *limits,
+    };
 
     v.name(&case.name, "name");
-    v.finite(&case.gravity, "gravity");
+    v.bounded(&case.gravity, MAX_GRAVITY, "gravity", "m/s²");
+    if case.parameters.len() as u64 > limits.parameters {
+        v.push(too_large(
+            "parameters",
+            "parameters",
+            case.parameters.len() as f64,
+            Limit::Parameters,
+            limits.parameters,
+        ));
+        return Err(CaseErrors::new(v.errors));
+    }
 
     // ---- parameters and coordinates: the names expressions may use
     let mut names: HashMap<String, String> = HashMap::new();
@@ -192,6 +338,8 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
         }
         if !value.is_finite() {
             v.invalid(&path, format!("{value} is not a finite number"));
+        } else {
+            v.magnitude(value, MAX_PARAMETER, &path, "");
         }
         names.insert(name.to_string(), path);
         parameters.insert(name.to_string(), value);
@@ -204,7 +352,7 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
                 case.coordinates.len()
             ),
         );
-        return Err(CaseErrors { errors: v.errors });
+        return Err(CaseErrors::new(v.errors));
     }
     let mut coordinates = Vec::new();
     let mut coordinates_ok = true;
@@ -222,7 +370,11 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
         }
         coordinates_ok &= v.unique(&mut names, &c.name, format!("{path}.name"), "name");
         let range_path = format!("{path}.range");
-        if !v.finite(&c.range, &range_path) {
+        let (max, unit) = match c.kind {
+            CoordinateKindSpec::Angle => (MAX_ANGLE, "rad"),
+            CoordinateKindSpec::Length => (MAX_LENGTH, "m"),
+        };
+        if !v.bounded(&c.range, max, &range_path, unit) {
             coordinates_ok = false;
         } else if c.range[0] >= c.range[1] {
             v.invalid(
@@ -247,6 +399,7 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
             .map(|c| (c.name.clone(), c.kind))
             .collect(),
     );
+    let context = context.with_limits(limits.expressions());
     let parser = Parser { context: &context };
 
     // ---- bodies: names, parents, inertial data, poses
@@ -284,16 +437,24 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
     let mut inertial = Vec::new();
     for (i, b) in case.bodies.iter().enumerate() {
         let path = format!("bodies[{i}]");
-        let pose = parser.pose(&b.pose, &format!("{path}.pose"), &mut v.errors);
-        relative.push(pose.map(|mut p| {
-            p.prune();
-            p
-        }));
-        v.non_negative(b.mass, &format!("{path}.mass"));
+        let pose_path = format!("{path}.pose");
+        relative.push(
+            v.list_size(b.pose.len(), &pose_path)
+                .then(|| parser.pose(&b.pose, &pose_path, &mut v.errors))
+                .flatten()
+                .map(|mut pose| {
+                    pose.prune();
+                    pose
+                })
+                .filter(|pose| pose_in_bounds(&mut v, pose, &pose_path)),
+        );
+        v.non_negative_at_most(b.mass, MAX_MASS, &format!("{path}.mass"), "kg");
         let com = match &b.com {
-            Some(e) => parser
-                .constant_vec(e, &format!("{path}.com"), &mut v.errors)
-                .map(Vector3::from),
+            Some(e) => {
+                let com_path = format!("{path}.com");
+                let value = parser.constant_vec(e, &com_path, &mut v.errors);
+                v.length_vec(value, &com_path).map(Vector3::from)
+            }
             None if b.mass > 0.0 => {
                 v.invalid(format!("{path}.com"), "required when mass > 0");
                 None
@@ -310,15 +471,16 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
         };
         inertial.push((com, inertia));
     }
-    let world = world_poses(&parents, &relative, &on_cycle);
+    let world = world_poses(&mut v, &parents, &relative, &on_cycle);
 
     // ---- payloads
     let mut payloads = Vec::new();
     for (i, p) in case.payloads.iter().enumerate() {
         let path = format!("payloads[{i}]");
         let body = carried_body(&mut v, &body_id, &p.body, &format!("{path}.body"));
-        v.non_negative(p.mass, &format!("{path}.mass"));
+        v.non_negative_at_most(p.mass, MAX_MASS, &format!("{path}.mass"), "kg");
         let com = parser.constant_vec(&p.com, &format!("{path}.com"), &mut v.errors);
+        let com = v.length_vec(com, &format!("{path}.com"));
         let inertia = v.inertia(&p.inertia.unwrap_or([0.0; 6]), &format!("{path}.inertia"));
         if let (Some(body), Some(com), Some(inertia)) = (body, com, inertia) {
             payloads.push(Payload {
@@ -407,7 +569,7 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
                 None
             }
         };
-        v.positive(a.ratio, &format!("{path}.ratio"));
+        v.positive_at_most(a.ratio, MAX_RATIO, &format!("{path}.ratio"), "");
         if let (Some(map), Some(k)) = (map, joint_index) {
             if let Some(Some(joint)) = joints.get(k)
                 && let Some(problem) = joints::check_actuator_follows_joint(
@@ -460,7 +622,7 @@ pub fn validate(case: Case) -> Result<Model, CaseErrors> {
     let paths = task_paths(&mut v, &case, &parser, &body_id);
 
     if !v.errors.is_empty() {
-        return Err(CaseErrors { errors: v.errors });
+        return Err(CaseErrors::new(v.errors));
     }
     let bodies = case
         .bodies
@@ -548,43 +710,87 @@ fn find_cycles(v: &mut Validator, case: &Case, parents: &[Option<BodyId>]) -> Ve
 }
 
 /// World poses `parent world · relative`, or `None` where a pose step, a parent, or a cycle
-/// prevents it.
+/// prevents it. Iterative (a chain of thousands of bodies must not deepen the call stack), and
+/// a composition whose degree would pass [`MAX_POSE_DEGREE`] is refused at the body's pose.
 fn world_poses(
+    v: &mut Validator,
     parents: &[Option<BodyId>],
     relative: &[Option<PolyPose>],
     on_cycle: &[bool],
 ) -> Vec<Option<PolyPose>> {
-    fn resolve(
-        i: usize,
-        parents: &[Option<BodyId>],
-        relative: &[Option<PolyPose>],
-        on_cycle: &[bool],
-        memo: &mut Vec<Option<Option<PolyPose>>>,
-    ) -> Option<PolyPose> {
-        if let Some(done) = &memo[i] {
-            return done.clone();
+    let n = parents.len();
+    let mut memo: Vec<Option<Option<PolyPose>>> = vec![None; n];
+    for start in 0..n {
+        // Walk up to a resolved body or the base, then resolve the chain back down.
+        let mut chain = Vec::new();
+        let mut current = start;
+        while memo[current].is_none() {
+            chain.push(current);
+            match parents[current] {
+                Some(BodyId::Body(p)) if !on_cycle[current] => current = p,
+                _ => break,
+            }
         }
-        let pose = if on_cycle[i] {
-            None
-        } else {
-            let parent = match parents[i] {
-                None => None,
-                Some(BodyId::Base) => Some(PolyPose::identity()),
-                Some(BodyId::Body(p)) => resolve(p, parents, relative, on_cycle, memo),
+        for &i in chain.iter().rev() {
+            let pose = if on_cycle[i] {
+                None
+            } else {
+                let parent = match parents[i] {
+                    None => None,
+                    Some(BodyId::Base) => Some(PolyPose::identity()),
+                    Some(BodyId::Body(p)) => memo[p].clone().flatten(),
+                };
+                parent.zip(relative[i].as_ref()).and_then(|(parent, rel)| {
+                    let degree = parent.degree() + rel.degree();
+                    if degree > MAX_POSE_DEGREE {
+                        v.invalid(
+                            format!("bodies[{i}].pose"),
+                            format!(
+                                "the world pose reaches degree {degree} in one coordinate; at most {MAX_POSE_DEGREE} is supported"
+                            ),
+                        );
+                        return None;
+                    }
+                    let mut pose = parent.compose(rel);
+                    pose.prune();
+                    Some(pose)
+                })
             };
-            parent.zip(relative[i].as_ref()).map(|(parent, rel)| {
-                let mut pose = parent.compose(rel);
-                pose.prune();
-                pose
-            })
-        };
-        memo[i] = Some(pose.clone());
-        pose
+            memo[i] = Some(pose);
+        }
     }
-    let mut memo = vec![None; parents.len()];
-    (0..parents.len())
-        .map(|i| resolve(i, parents, relative, on_cycle, &mut memo))
-        .collect()
+    memo.into_iter().map(Option::flatten).collect()
+}
+
+/// Checks a body's relative pose: translations within [`MAX_LENGTH`] and degree within
+/// [`MAX_POSE_DEGREE`].
+fn pose_in_bounds(v: &mut Validator, pose: &PolyPose, path: &str) -> bool {
+    let degree = pose.degree();
+    if degree > MAX_POSE_DEGREE {
+        v.invalid(
+            path,
+            format!("the pose reaches degree {degree} in one coordinate; at most {MAX_POSE_DEGREE} is supported"),
+        );
+        return false;
+    }
+    let largest = pose
+        .origin
+        .0
+        .iter()
+        .map(TrigPoly::max_abs_coefficient)
+        .fold(0.0, f64::max);
+    if !largest.is_finite() || largest > MAX_LENGTH {
+        v.invalid(
+            path,
+            format!(
+                "its translations reach {} m, beyond the supported magnitude ±{} m",
+                num(largest),
+                num(MAX_LENGTH)
+            ),
+        );
+        return false;
+    }
+    true
 }
 
 /// The length scale of joint tolerances: the largest distance of a body origin from the base
@@ -674,7 +880,11 @@ fn joint(
         ok = false;
     }
     let point = match &j.point {
-        Some(e) => parser.constant_vec(e, &format!("{path}.point"), &mut v.errors),
+        Some(e) => {
+            let point_path = format!("{path}.point");
+            let point = parser.constant_vec(e, &point_path, &mut v.errors);
+            v.length_vec(point, &point_path)
+        }
         None if kind == JointKind::Orientation => Some([0.0; 3]),
         None => {
             v.invalid(
@@ -825,6 +1035,14 @@ fn balancing(
     let start = v.errors.len();
     if b.dmax < 1 {
         v.invalid("balancing.dmax", "must be an integer ≥ 1");
+    } else if u64::from(b.dmax) > v.limits.dmax {
+        v.push(too_large(
+            "balancing.dmax",
+            "elements per variant",
+            f64::from(b.dmax),
+            Limit::Dmax,
+            v.limits.dmax,
+        ));
     }
     let counterweights = b.counterweights.as_ref().and_then(|c| {
         let bodies = selection(
@@ -835,13 +1053,17 @@ fn balancing(
             "the base cannot carry a counterweight",
         );
         let shape = c.shape.as_ref().map(|ShapeSpec::Cylinder(cyl)| {
-            v.positive(
+            v.positive_at_most(
                 cyl.radius_to_thickness,
+                1e3,
                 "balancing.counterweights.shape.cylinder.radius_to_thickness",
+                "",
             );
-            v.positive(
+            v.positive_at_most(
                 cyl.density,
+                MAX_DENSITY,
                 "balancing.counterweights.shape.cylinder.density",
+                "kg/m³",
             );
             CounterweightShape::Cylinder {
                 radius_to_thickness: cyl.radius_to_thickness,
@@ -870,18 +1092,37 @@ fn balancing(
     });
     let defaults = Bounds::default();
     let spec = b.bounds.clone().unwrap_or_default();
-    let mut bound = |value: Option<[f64; 2]>, default: [f64; 2], name: &str| match value {
+    let mut bound = |value: Option<[f64; 2]>, default: [f64; 2], name: &str, max, unit| match value
+    {
         Some(x) => v
-            .interval(x, &format!("balancing.bounds.{name}"))
+            .interval(x, max, unit, &format!("balancing.bounds.{name}"))
             .unwrap_or(default),
         None => default,
     };
     let bounds = Bounds {
-        mass: bound(spec.mass, defaults.mass, "mass"),
-        radius: bound(spec.radius, defaults.radius, "radius"),
-        stiffness: bound(spec.stiffness, defaults.stiffness, "stiffness"),
-        anchor_a: bound(spec.anchor_a, defaults.anchor_a, "anchor_a"),
-        anchor_b: bound(spec.anchor_b, defaults.anchor_b, "anchor_b"),
+        mass: bound(spec.mass, defaults.mass, "mass", MAX_MASS, "kg"),
+        radius: bound(spec.radius, defaults.radius, "radius", MAX_LENGTH, "m"),
+        stiffness: bound(
+            spec.stiffness,
+            defaults.stiffness,
+            "stiffness",
+            MAX_STIFFNESS,
+            "N/m",
+        ),
+        anchor_a: bound(
+            spec.anchor_a,
+            defaults.anchor_a,
+            "anchor_a",
+            MAX_LENGTH,
+            "m",
+        ),
+        anchor_b: bound(
+            spec.anchor_b,
+            defaults.anchor_b,
+            "anchor_b",
+            MAX_LENGTH,
+            "m",
+        ),
     };
     let mut peak_limits = vec![None; case.actuators.len()];
     for (name, &limit) in b.peak_limits.iter() {
@@ -889,7 +1130,7 @@ fn balancing(
         match actuator_index(name) {
             None => v.unknown(&path, "actuator", name),
             Some(k) => {
-                if v.positive(limit, &path) {
+                if v.positive_at_most(limit, MAX_TORQUE, &path, "N·m") {
                     peak_limits[k] = Some(limit);
                 }
             }
@@ -919,7 +1160,7 @@ fn tasks(
             v.unknown(&path, "actuator", name);
             continue;
         };
-        if !v.finite(&[from, to, n], &path) {
+        if !v.bounded(&[from, to], MAX_LENGTH.max(MAX_ANGLE), &path, "") || !v.finite(&[n], &path) {
             continue;
         }
         if n < 1.0 || n.fract() != 0.0 {
@@ -927,6 +1168,16 @@ fn tasks(
                 format!("{path}[2]"),
                 format!("the number of values must be an integer ≥ 1 (found {n})"),
             );
+            continue;
+        }
+        if n > v.limits.grid_points as f64 {
+            v.push(too_large(
+                &format!("{path}[2]"),
+                "values on one axis",
+                n,
+                Limit::GridPoints,
+                v.limits.grid_points,
+            ));
             continue;
         }
         grid[k] = Some(GridAxis {
@@ -951,12 +1202,23 @@ fn tasks(
             ),
         );
     }
-    v.positive(t.duration, "tasks.duration");
+    if v.errors.len() == start {
+        grid_size(v, &grid, t);
+    }
+    v.duration(t.duration, "tasks.duration");
     if t.samples < 2 {
         v.invalid(
             "tasks.samples",
             format!("must be ≥ 2 (found {})", t.samples),
         );
+    } else if u64::from(t.samples) > v.limits.samples {
+        v.push(too_large(
+            "tasks.samples",
+            "samples per task",
+            f64::from(t.samples),
+            Limit::Samples,
+            v.limits.samples,
+        ));
     }
     (v.errors.len() == start).then(|| Tasks {
         grid: grid.into_iter().map(|g| g.expect("checked")).collect(),
@@ -970,6 +1232,58 @@ fn tasks(
         duration: t.duration,
         samples: t.samples as usize,
     })
+}
+
+/// The number of tasks of a grid of `points` points (computed in floating point: it must not
+/// overflow before it is compared with a limit).
+pub fn task_count(points: f64, pairs: PairMode) -> f64 {
+    match pairs {
+        PairMode::All => points * (points - 1.0) / 2.0,
+        PairMode::Ordered => points * (points - 1.0),
+    }
+}
+
+/// Checks the grid's point count, task count and evaluations against the limits, from the axis
+/// sizes alone (the grid is not built), and refuses a grid of one point: a task moves between
+/// two points.
+fn grid_size(v: &mut Validator, grid: &[Option<GridAxis>], t: &TasksSpec) {
+    let sizes: Vec<f64> = grid.iter().flatten().map(|g| g.n as f64).collect();
+    let points: f64 = sizes.iter().product();
+    if points > v.limits.grid_points as f64 {
+        v.push(too_large(
+            "tasks.grid",
+            "grid points",
+            points,
+            Limit::GridPoints,
+            v.limits.grid_points,
+        ));
+        return;
+    }
+    if points < 2.0 {
+        v.invalid(
+            "tasks.grid",
+            "the grid has a single point (every axis has n = 1), so there is no move between two points: give some actuator n ≥ 2",
+        );
+        return;
+    }
+    let pairs = match t.pairs {
+        PairsSpec::All => PairMode::All,
+        PairsSpec::Ordered => PairMode::Ordered,
+    };
+    let evaluations = task_count(points, pairs) * f64::from(t.samples.max(2));
+    if evaluations > v.limits.task_samples as f64 {
+        v.push(too_large(
+            "tasks",
+            &format!(
+                "evaluations ({} tasks × {} samples)",
+                crate::limits::format_count(task_count(points, pairs)),
+                t.samples
+            ),
+            evaluations,
+            Limit::TaskSamples,
+            v.limits.task_samples,
+        ));
+    }
 }
 
 fn task_paths(
@@ -986,6 +1300,12 @@ fn task_paths(
         v.name(&p.name, &format!("{path}.name"));
         v.unique(&mut names, &p.name, format!("{path}.name"), "path");
         let mut waypoints = Vec::new();
+        let sizes_ok = v.list_size(p.waypoints.len(), &format!("{path}.waypoints"))
+            & v.list_size(p.sequence.len(), &format!("{path}.sequence"))
+            & v.list_size(p.durations.len(), &format!("{path}.durations"));
+        if !sizes_ok {
+            continue;
+        }
         for (name, u) in p.waypoints.iter() {
             let wp = format!("{path}.waypoints.{name}");
             if u.len() != case.actuators.len() {
@@ -998,7 +1318,7 @@ fn task_paths(
                     ),
                 );
             }
-            v.finite(u, &wp);
+            v.bounded(u, MAX_LENGTH.max(MAX_ANGLE), &wp, "");
             waypoints.push(Waypoint {
                 name: name.to_string(),
                 u: u.clone(),
@@ -1025,13 +1345,14 @@ fn task_paths(
             );
         }
         for (k, &d) in p.durations.iter().enumerate() {
-            v.positive(d, &format!("{path}.durations[{k}]"));
+            v.duration(d, &format!("{path}.durations[{k}]"));
         }
         let payload = p.payload.as_ref().and_then(|pl| {
             let pp = format!("{path}.payload");
             let body = carried_body(v, body_id, &pl.body, &format!("{pp}.body"));
-            v.positive(pl.mass, &format!("{pp}.mass"));
+            v.positive_at_most(pl.mass, MAX_MASS, &format!("{pp}.mass"), "kg");
             let com = parser.constant_vec(&pl.com, &format!("{pp}.com"), &mut v.errors);
+            let com = v.length_vec(com, &format!("{pp}.com"));
             let inertia = v.inertia(&pl.inertia.unwrap_or([0.0; 6]), &format!("{pp}.inertia"));
             let pick = p.sequence.iter().position(|s| *s == pl.pick_at);
             if pick.is_none() {

@@ -465,7 +465,7 @@ fn balancing_tasks_and_paths() {
     expect_error(
         |v| v["tasks"]["duration"] = json!(0),
         "tasks.duration",
-        "> 0",
+        "between 0.001 and 1000000 s",
     );
     expect_error(|v| v["tasks"]["samples"] = json!(1), "tasks.samples", "≥ 2");
     expect_error(

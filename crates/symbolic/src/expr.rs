@@ -31,13 +31,46 @@ pub struct ExprError {
     pub reason: String,
 }
 
+/// Size limits of one expression.
+///
+/// The parser and the lowering recurse once per nesting level, so an unbounded depth would let
+/// a case file (12,000 nested parentheses, a 20,000-term sum) overflow the stack; the length
+/// bound keeps a single field from costing more than a few milliseconds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExprLimits {
+    /// Most bytes of source text.
+    pub length: usize,
+    /// Deepest syntax tree: each parenthesis, unary sign, function call and each operator of
+    /// a chain (`a + b + c` is two levels) adds one level.
+    pub depth: usize,
+}
+
+/// Default [`ExprLimits::length`].
+pub const MAX_EXPRESSION_LENGTH: usize = 10_000;
+/// Default [`ExprLimits::depth`]: far beyond any hand-written pose, far below what the stack of
+/// a 2 MB thread holds.
+pub const MAX_EXPRESSION_DEPTH: usize = 256;
+
+impl Default for ExprLimits {
+    fn default() -> Self {
+        ExprLimits {
+            length: MAX_EXPRESSION_LENGTH,
+            depth: MAX_EXPRESSION_DEPTH,
+        }
+    }
+}
+
 /// Names known to expressions: parameters and the chart coordinates (index = position), over
 /// the coefficient field `F` ([`ExprContext`] for `f64`, [`ExactContext`] for exact rationals).
 #[derive(Clone, Debug)]
 pub struct Context<F: Field> {
     parameters: BTreeMap<String, F::Constant>,
     coordinates: Vec<(String, VarKind)>,
+    limits: ExprLimits,
 }
+
+/// An angle as `(integer multiples of angle coordinates, sorted by index; constant part)`.
+pub type AngleParts<C> = (Vec<(usize, i32)>, C);
 
 /// The numeric expression context (the model's workhorse).
 pub type ExprContext = Context<f64>;
@@ -50,6 +83,7 @@ impl<F: Field> Default for Context<F> {
         Context {
             parameters: BTreeMap::new(),
             coordinates: Vec::new(),
+            limits: ExprLimits::default(),
         }
     }
 }
@@ -62,7 +96,14 @@ impl<F: Field> Context<F> {
         Context {
             parameters,
             coordinates,
+            limits: ExprLimits::default(),
         }
+    }
+
+    /// The same context with other size limits.
+    pub fn with_limits(mut self, limits: ExprLimits) -> Self {
+        self.limits = limits;
+        self
     }
 
     pub fn coordinates(&self) -> &[(String, VarKind)] {
@@ -86,10 +127,7 @@ impl<F: Field> Context<F> {
     }
 
     /// Parses an angle: integer multiples of angle coordinates (sorted by index) and a constant.
-    pub fn parse_angle_parts(
-        &self,
-        src: &str,
-    ) -> Result<(Vec<(usize, i32)>, F::Constant), ExprError> {
+    pub fn parse_angle_parts(&self, src: &str) -> Result<AngleParts<F::Constant>, ExprError> {
         let (ast, span) = self.parse(src)?;
         let value = self.lower(src, &ast)?;
         to_angle(src, span, value)
@@ -115,11 +153,24 @@ impl<F: Field> Context<F> {
     }
 
     fn parse(&self, src: &str) -> Result<(Node, Span), ExprError> {
+        if src.len() > self.limits.length {
+            return Err(error(
+                src,
+                Span { start: 0, end: 0 },
+                &format!(
+                    "the expression has {} bytes; the limit is {}",
+                    src.len(),
+                    self.limits.length
+                ),
+            ));
+        }
         let tokens = tokenize(src)?;
         let mut parser = Parser {
             src,
             tokens,
             pos: 0,
+            nesting: 0,
+            max_depth: self.limits.depth,
         };
         let node = parser.expression(0)?;
         if let Some(tok) = parser.tokens.get(parser.pos) {
@@ -381,7 +432,7 @@ fn to_angle<F: Field>(
     src: &str,
     span: Span,
     value: Value<F>,
-) -> Result<(Vec<(usize, i32)>, F::Constant), ExprError> {
+) -> Result<AngleParts<F::Constant>, ExprError> {
     let affine = match value {
         Value::Affine(a) => a,
         Value::Poly(p) if p.is_constant() => Affine {
@@ -430,10 +481,21 @@ impl Span {
     }
 }
 
+/// Longest expression or part quoted in an error, in characters: a 10,000-byte expression is
+/// named by its start, not printed whole.
+const MAX_QUOTED: usize = 120;
+
+fn quote(text: &str) -> String {
+    match text.char_indices().nth(MAX_QUOTED) {
+        None => text.to_string(),
+        Some((cut, _)) => format!("{}…", &text[..cut]),
+    }
+}
+
 fn error(src: &str, span: Span, reason: &str) -> ExprError {
     ExprError {
-        expr: src.to_string(),
-        part: src.get(span.start..span.end).unwrap_or(src).to_string(),
+        expr: quote(src),
+        part: quote(src.get(span.start..span.end).unwrap_or(src)),
         reason: reason.to_string(),
     }
 }
@@ -514,8 +576,8 @@ fn tokenize(src: &str) -> Result<Vec<Token>, ExprError> {
     }
     if tokens.is_empty() {
         return Err(ExprError {
-            expr: src.to_string(),
-            part: src.to_string(),
+            expr: quote(src),
+            part: quote(src),
             reason: "empty expression".to_string(),
         });
     }
@@ -526,6 +588,8 @@ fn tokenize(src: &str) -> Result<Vec<Token>, ExprError> {
 struct Node {
     kind: NodeKind,
     span: Span,
+    /// Height of the tree below and including this node (a leaf is 1).
+    depth: usize,
 }
 
 #[derive(Clone, Debug)]
@@ -541,6 +605,10 @@ struct Parser<'a> {
     src: &'a str,
     tokens: Vec<Token>,
     pos: usize,
+    /// Recursive calls of [`Parser::expression`] now active.
+    nesting: usize,
+    /// Deepest tree (and deepest recursion) allowed.
+    max_depth: usize,
 }
 
 /// Binding powers (left, right): `^` is right-associative and binds tighter than unary minus.
@@ -565,7 +633,40 @@ impl Parser<'_> {
         Span { start: 0, end }
     }
 
+    /// Refuses a tree deeper than the limit, naming the part that reached it.
+    fn check_depth(&self, depth: usize, span: Span) -> Result<(), ExprError> {
+        if depth > self.max_depth {
+            return Err(error(
+                self.src,
+                span,
+                &format!(
+                    "the expression nests deeper than {} levels (parentheses, signs, calls and chained operators)",
+                    self.max_depth
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Builds a node one level above its deepest child, refusing it past the depth limit.
+    fn node(&self, kind: NodeKind, span: Span, child_depth: usize) -> Result<Node, ExprError> {
+        let depth = child_depth + 1;
+        self.check_depth(depth, span)?;
+        Ok(Node { kind, span, depth })
+    }
+
     fn expression(&mut self, min_power: u8) -> Result<Node, ExprError> {
+        // The recursion depth is bounded before recursing, so that no input can exhaust the
+        // stack; the tree depth (which also grows along operator chains) is bounded in `node`.
+        self.nesting += 1;
+        let start = self.peek().map_or(self.end_span(), |t| t.span);
+        self.check_depth(self.nesting, start)?;
+        let result = self.expression_inner(min_power);
+        self.nesting -= 1;
+        result
+    }
+
+    fn expression_inner(&mut self, min_power: u8) -> Result<Node, ExprError> {
         let mut lhs = self.prefix()?;
         while let Some(Token {
             tok: Tok::Op(op), ..
@@ -578,10 +679,12 @@ impl Parser<'_> {
             self.pos += 1;
             let rhs = self.expression(right)?;
             let span = lhs.span.join(rhs.span);
-            lhs = Node {
-                kind: NodeKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+            let depth = lhs.depth.max(rhs.depth);
+            lhs = self.node(
+                NodeKind::Binary(op, Box::new(lhs), Box::new(rhs)),
                 span,
-            };
+                depth,
+            )?;
         }
         Ok(lhs)
     }
@@ -596,17 +699,12 @@ impl Parser<'_> {
         };
         self.pos += 1;
         match token.tok {
-            Tok::Number(x) => Ok(Node {
-                kind: NodeKind::Number(x),
-                span: token.span,
-            }),
+            Tok::Number(x) => self.node(NodeKind::Number(x), token.span, 0),
             Tok::Op('-') => {
                 let inner = self.expression(UNARY_MINUS_POWER)?;
                 let span = token.span.join(inner.span);
-                Ok(Node {
-                    kind: NodeKind::Neg(Box::new(inner)),
-                    span,
-                })
+                let depth = inner.depth;
+                self.node(NodeKind::Neg(Box::new(inner)), span, depth)
             }
             Tok::Op('+') => self.expression(UNARY_MINUS_POWER),
             Tok::Open => {
@@ -629,15 +727,10 @@ impl Parser<'_> {
                         args.push(self.expression(0)?);
                     }
                     let close = self.expect_close(token.span)?;
-                    Ok(Node {
-                        kind: NodeKind::Call(name, args),
-                        span: token.span.join(close),
-                    })
+                    let depth = args.iter().map(|a| a.depth).max().unwrap_or(0);
+                    self.node(NodeKind::Call(name, args), token.span.join(close), depth)
                 } else {
-                    Ok(Node {
-                        kind: NodeKind::Name(name),
-                        span: token.span,
-                    })
+                    self.node(NodeKind::Name(name), token.span, 0)
                 }
             }
             _ => Err(error(self.src, token.span, "unexpected token")),
@@ -739,5 +832,95 @@ mod tests {
             "cos(th1)^64*cos(th1)^64*cos(th1)^64",
         );
         refused("(rho^60)^3", "rho^60");
+    }
+
+    /// Runs `work` on a thread with a 2 MB stack (a test thread's default), so that a
+    /// recursion the limits fail to bound shows up as a crash here.
+    fn on_small_stack<T: Send + 'static>(work: impl FnOnce() -> T + Send + 'static) -> T {
+        std::thread::Builder::new()
+            .stack_size(2 << 20)
+            .spawn(work)
+            .unwrap()
+            .join()
+            .unwrap()
+    }
+
+    #[test]
+    fn hostile_nesting_is_refused_not_a_stack_overflow() {
+        let depth = MAX_EXPRESSION_DEPTH;
+        // Each under the length limit, so that the depth limit is what refuses it.
+        let cases = [
+            format!("{}1{}", "(".repeat(4_000), ")".repeat(4_000)),
+            format!("{}1", "-".repeat(9_000)),
+            format!("{}1", "+".repeat(9_000)),
+            vec!["d1"; 3_000].join("+"),
+            vec!["2"; 3_000].join("^"),
+            format!("{}th1{}", "cos(".repeat(1_500), ")".repeat(1_500)),
+        ];
+        for src in cases {
+            assert!(src.len() <= MAX_EXPRESSION_LENGTH);
+            let shown = src.chars().take(20).collect::<String>();
+            let err = on_small_stack(move || context().parse_poly(&src).unwrap_err());
+            assert!(
+                err.reason.contains(&format!("deeper than {depth}")),
+                "{shown}: {err}"
+            );
+            assert!(
+                err.expr.chars().count() <= 121,
+                "the error quotes a clipped expression"
+            );
+        }
+    }
+
+    #[test]
+    fn the_sizes_of_the_issue_are_refused_by_length() {
+        for src in [
+            format!("{}1{}", "(".repeat(12_000), ")".repeat(12_000)),
+            format!("{}1", "-".repeat(30_000)),
+            vec!["d1"; 20_000].join("+"),
+        ] {
+            let err = on_small_stack(move || context().parse_poly(&src).unwrap_err());
+            assert!(err.reason.contains("the limit is 10000"), "{err}");
+        }
+    }
+
+    #[test]
+    fn nesting_up_to_the_limit_is_accepted_on_a_small_stack() {
+        // A chain of n − 1 additions is a tree of depth n; nested parentheses add recursion but
+        // no tree level; each unary minus adds one of both.
+        let n = MAX_EXPRESSION_DEPTH;
+        let sum = vec!["1"; n].join("+");
+        assert_eq!(
+            on_small_stack(move || context().parse_constant(&sum)),
+            Ok(n as f64)
+        );
+        let parens = format!("{}2{}", "(".repeat(n - 1), ")".repeat(n - 1));
+        assert_eq!(
+            on_small_stack(move || context().parse_constant(&parens)),
+            Ok(2.0)
+        );
+        let minus = format!("{}3", "-".repeat(n - 1));
+        let expected = if (n - 1).is_multiple_of(2) { 3.0 } else { -3.0 };
+        assert_eq!(
+            on_small_stack(move || context().parse_constant(&minus)),
+            Ok(expected)
+        );
+        let too_deep = vec!["1"; n + 1].join("+");
+        assert!(on_small_stack(move || context().parse_constant(&too_deep)).is_err());
+    }
+
+    #[test]
+    fn long_expressions_are_refused_by_length() {
+        let long = format!("1{}", "+0".repeat(MAX_EXPRESSION_LENGTH));
+        let err = context().parse_constant(&long).unwrap_err();
+        assert!(err.reason.contains("the limit is 10000"), "{err}");
+        assert!(err.to_string().len() < 400, "{err}");
+        // With the length limit lifted the same text gets as far as the depth limit.
+        let relaxed = context().with_limits(ExprLimits {
+            length: 30_000,
+            depth: MAX_EXPRESSION_DEPTH,
+        });
+        let err = on_small_stack(move || relaxed.parse_constant(&long).unwrap_err());
+        assert!(err.reason.contains("deeper than"), "{err}");
     }
 }

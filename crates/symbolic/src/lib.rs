@@ -20,7 +20,10 @@ pub mod poly;
 pub mod scalar;
 
 pub use angle::LinearAngle;
-pub use expr::{Context, ExactContext, ExprContext, ExprError};
+pub use expr::{
+    Context, ExactContext, ExprContext, ExprError, ExprLimits, MAX_EXPRESSION_DEPTH,
+    MAX_EXPRESSION_LENGTH,
+};
 pub use field::{ExactConstant, Field};
 pub use geometry::{ExactMat3, ExactVec3, Mat3, PolyMat3, PolyVec3, Vec3};
 pub use monomial::{MAX_VARS, Monomial, VarKind};

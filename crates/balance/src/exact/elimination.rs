@@ -15,6 +15,10 @@ use num_traits::{Signed, Zero};
 
 use counterpoise_symbolic::Rational;
 
+/// One solved row: `(pivot column, [(free column, coefficient)], value)`, meaning
+/// `x_pivot + Σ coefficient·x_free = value`.
+pub type Relation = (usize, Vec<(usize, Rational)>, Rational);
+
 /// The echelon form of `[A | r]` after Gauss–Jordan elimination.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Echelon {
@@ -51,7 +55,7 @@ impl Echelon {
     }
 
     /// Each row as `x_pivot + Σ coefficient·x_j = value` (coefficients of the free columns).
-    pub fn relations(&self) -> Vec<(usize, Vec<(usize, Rational)>, Rational)> {
+    pub fn relations(&self) -> Vec<Relation> {
         self.rows
             .iter()
             .zip(&self.pivots)

@@ -116,7 +116,7 @@ pub fn contradiction(
         let stiffness = solution.affine(start);
         let mut required: Option<Rational> = None;
         let mut form = String::new();
-        for r in 0..basis.monomials.len() {
+        for (r, factor) in basis.row_factors.iter().enumerate() {
             let weights: Vec<Rational> = (0..na * nb)
                 .map(|ij| Rational::from_integer(columns[1 + na + nb + ij][r].clone()))
                 .collect();
@@ -143,13 +143,13 @@ pub fn contradiction(
                         "{}: no spring has the anchors balance requires (K·W − α·βᵀ = {} for \
                          every K)",
                         entry.label,
-                        exact_text(&(c0 / &basis.row_factors[r]))
+                        exact_text(&(c0 / factor))
                     ));
                 }
                 Demand::Stiffness { c0, c1 } => {
                     let value = -&c0 / &c1;
                     // In physical units (J per unit), undoing the row's integer scaling.
-                    let (c0, c1) = (c0 / &basis.row_factors[r], c1 / &basis.row_factors[r]);
+                    let (c0, c1) = (c0 / factor, c1 / factor);
                     form = if c0.is_zero() {
                         format!("K·W − α·βᵀ = {}·K", exact_text(&c1))
                     } else {
