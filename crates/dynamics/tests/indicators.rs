@@ -210,3 +210,28 @@ fn an_empty_accumulator_gives_zeros_not_nan() {
     assert_eq!(s.total_peak, 0.0);
     assert_eq!(s.force_peak, [0.0]);
 }
+
+/// Three actuators and one joint (with two actuators `2·n` and `2 + n` coincide): the row
+/// layout `[rms (3), peak (3), total, force (1), moment (1)]` written by hand is read back
+/// field by field.
+#[test]
+fn row_layout_with_three_actuators() {
+    let mut t = StatsTable::new(1, 1, 3, 1);
+    assert_eq!(t.width(), 9);
+    t.set_rows(0, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+    let s = t.get(0, 0).unwrap();
+    assert_eq!(s.rms, [1.0, 2.0, 3.0]);
+    assert_eq!(s.peak, [4.0, 5.0, 6.0]);
+    assert_eq!(s.total_peak, 7.0);
+    assert_eq!(s.force_peak, [8.0]);
+    assert_eq!(s.moment_peak, [9.0]);
+    // and `set` writes the same layout
+    let mut u = StatsTable::new(1, 1, 3, 1);
+    u.set(0, std::slice::from_ref(&s));
+    assert_eq!(u.row(0, 0).unwrap(), t.row(0, 0).unwrap());
+    let actuators = ["M1", "M2", "M3"].map(String::from);
+    let ind = reduce(&t, 0, &actuators, &["J1".to_string()], |w| (w, w));
+    assert_eq!((ind.qtr, ind.qit), (6.0, 7.0));
+    assert_eq!(ind.actuators[2].cpt_peak, 6.0);
+    assert_eq!((ind.joints[0].force, ind.joints[0].moment), (8.0, 9.0));
+}
