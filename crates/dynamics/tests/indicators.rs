@@ -149,6 +149,12 @@ fn rows_round_trip_and_excluded_tasks_have_none() {
     // ... and, being the lowest task now, it takes task 2's ties
     let ind = reduce(&t, 0, &names("M"), &names("J"), pair);
     assert_eq!(ind.qit_task, [0, 10]);
+    // copying onto a later task: task 3 takes task 1's rows (and task 1's ties go first)
+    let mut t = table();
+    t.copy_task(1, 3);
+    assert_eq!(t.row(3, 0).unwrap(), t.row(1, 0).unwrap());
+    assert_eq!(t.row(3, 1).unwrap(), t.row(1, 1).unwrap());
+    assert_eq!(t.get(2, 0).unwrap().total_peak, 7.0, "task 2 untouched");
     // copying an excluded task excludes the target
     let mut t = table();
     t.copy_task(0, 3);
@@ -234,4 +240,85 @@ fn row_layout_with_three_actuators() {
     assert_eq!((ind.qtr, ind.qit), (6.0, 7.0));
     assert_eq!(ind.actuators[2].cpt_peak, 6.0);
     assert_eq!((ind.joints[0].force, ind.joints[0].moment), (8.0, 9.0));
+}
+
+/// The reduction written out plainly over `TaskStats` (a second implementation): per quantity
+/// the first task that ran with the largest value.
+fn plain_reduce(tasks: &[Option<TaskStats>]) -> (Vec<(f64, usize)>, Vec<(f64, usize)>) {
+    let argmax = |value: &dyn Fn(&TaskStats) -> f64| {
+        let mut best: Option<(f64, usize)> = None;
+        for (w, s) in tasks.iter().enumerate() {
+            if let Some(s) = s {
+                let v = value(s);
+                if best.is_none_or(|b| v > b.0) {
+                    best = Some((v, w));
+                }
+            }
+        }
+        best.unwrap()
+    };
+    let (na, nj) = (3, 2);
+    let mut motor = vec![argmax(&|s| s.rms.iter().sum()), argmax(&|s| s.total_peak)];
+    for a in 0..na {
+        motor.push(argmax(&|s| s.rms[a]));
+        motor.push(argmax(&|s| s.peak[a]));
+    }
+    let mut joints = Vec::new();
+    for j in 0..nj {
+        joints.push(argmax(&|s| s.force_peak[j]));
+        joints.push(argmax(&|s| s.moment_peak[j]));
+    }
+    (motor, joints)
+}
+
+proptest::proptest! {
+    /// Random tables (3 actuators, 2 joints, 6 tasks, some excluded, two columns): the crate's
+    /// reduction agrees with the plain one above on every value and critical task.
+    #[test]
+    fn reduction_agrees_with_a_plain_implementation(
+        values in proptest::collection::vec(0.0f64..100.0, 6 * 2 * 11),
+        ran in proptest::collection::vec(proptest::bool::weighted(0.8), 6),
+        column in 0usize..2,
+    ) {
+        proptest::prop_assume!(ran.iter().any(|&r| r));
+        let mut table = StatsTable::new(6, 2, 3, 2);
+        let mut plain = Vec::new();
+        for w in 0..6 {
+            let stats: Vec<TaskStats> = (0..2)
+                .map(|c| {
+                    let v = &values[(w * 2 + c) * 11..][..11];
+                    TaskStats {
+                        rms: v[0..3].to_vec(),
+                        peak: v[3..6].to_vec(),
+                        total_peak: v[6],
+                        force_peak: v[7..9].to_vec(),
+                        moment_peak: v[9..11].to_vec(),
+                    }
+                })
+                .collect();
+            if ran[w] {
+                table.set(w, &stats);
+            }
+            plain.push(ran[w].then(|| stats[column].clone()));
+        }
+        let actuators = ["M1", "M2", "M3"].map(String::from);
+        let joints = ["J1", "J2"].map(String::from);
+        let ind = reduce(&table, column, &actuators, &joints, pair);
+        let (motor, joint) = plain_reduce(&plain);
+        let task = |w: usize| [w, w + 10];
+        proptest::prop_assert_eq!((ind.qtr, ind.qtr_task), (motor[0].0, task(motor[0].1)));
+        proptest::prop_assert_eq!((ind.qit, ind.qit_task), (motor[1].0, task(motor[1].1)));
+        for a in 0..3 {
+            let (crt, cpt) = (motor[2 + 2 * a], motor[3 + 2 * a]);
+            let got = &ind.actuators[a];
+            proptest::prop_assert_eq!((got.crt_rms, got.crt), (crt.0, task(crt.1)));
+            proptest::prop_assert_eq!((got.cpt_peak, got.cpt), (cpt.0, task(cpt.1)));
+        }
+        for j in 0..2 {
+            let (f, m) = (joint[2 * j], joint[2 * j + 1]);
+            let got = &ind.joints[j];
+            proptest::prop_assert_eq!((got.force, got.force_task), (f.0, task(f.1)));
+            proptest::prop_assert_eq!((got.moment, got.moment_task), (m.0, task(m.1)));
+        }
+    }
 }
