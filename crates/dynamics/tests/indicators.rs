@@ -242,9 +242,12 @@ fn row_layout_with_three_actuators() {
     assert_eq!((ind.joints[0].force, ind.joints[0].moment), (8.0, 9.0));
 }
 
+/// `(largest value, its task)` per reduced quantity.
+type Maxima = Vec<(f64, usize)>;
+
 /// The reduction written out plainly over `TaskStats` (a second implementation): per quantity
 /// the first task that ran with the largest value.
-fn plain_reduce(tasks: &[Option<TaskStats>]) -> (Vec<(f64, usize)>, Vec<(f64, usize)>) {
+fn plain_reduce(tasks: &[Option<TaskStats>]) -> (Maxima, Maxima) {
     let argmax = |value: &dyn Fn(&TaskStats) -> f64| {
         let mut best: Option<(f64, usize)> = None;
         for (w, s) in tasks.iter().enumerate() {
