@@ -1,27 +1,10 @@
 //! End-to-end tests of the command line on the reference cases.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+use std::process::Output;
 
-fn counterpoise(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_counterpoise"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("the binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{assert_success, case_json, counterpoise, num, results, stderr, stdout, write_case};
 
 #[test]
 fn check_summarises_the_palletizer() {
@@ -40,14 +23,12 @@ fn check_summarises_the_palletizer() {
 
 #[test]
 fn check_reports_every_error_with_its_path_and_fails() {
-    let dir = std::env::temp_dir().join(format!("counterpoise-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string(root().join("cases/pendulum.json")).unwrap();
-    let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = case_json("pendulum.json");
     case["bodies"][0]["mass"] = serde_json::json!(-1.0);
     case["actuators"][0]["joint"] = serde_json::json!("nope");
-    let path = dir.join("bad.json");
-    std::fs::write(&path, serde_json::to_string(&case).unwrap()).unwrap();
+    let path = dir.path().join("bad.json");
+    write_case(dir.path(), "bad.json", &case);
     let out = counterpoise(&["check", path.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
     let err = stderr(&out);
@@ -60,7 +41,6 @@ fn check_reports_every_error_with_its_path_and_fails() {
     assert!(stderr(&out).contains("line 1"), "{}", stderr(&out));
     let out = counterpoise(&["check", "cases/does-not-exist.json"]);
     assert_eq!(out.status.code(), Some(1));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -104,9 +84,8 @@ fn variants_are_identical_with_one_and_two_threads() {
 fn evaluate_series_of_the_pendulum_matches_its_equation_of_motion() {
     // rod: m = 2 kg, CoM at L/2 = 0.5 m, I_zz about the CoM 0.1667 kg·m², ratio 0.01;
     // grid −1.5…1.5 rad in 5 points; move 0 → 4 is −1.5 → 1.5 rad in 1 s (quintic).
-    let dir = std::env::temp_dir().join(format!("counterpoise-series-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("series.json");
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("series.json");
     let out = counterpoise(&[
         "evaluate",
         "cases/pendulum.json",
@@ -137,5 +116,175 @@ fn evaluate_series_of_the_pendulum_matches_its_equation_of_motion() {
         let motor = s["motor_torque"][k][0].as_f64().unwrap();
         assert!((motor - ratio * expected).abs() < 1e-8 * (1.0 + expected.abs()));
     }
-    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The pendulum's motor torque by hand: `0.01·((I_zz + m c²) θ̈ + m g c cos θ)` along the
+/// quintic move `a → b` in 1 s, sampled at 21 points.
+fn pendulum_motor_torque(a: f64, b: f64) -> Vec<f64> {
+    let (m, c, g, i_zz, ratio) = (2.0, 0.5, 9.81, 0.1667, 0.01);
+    (0..21)
+        .map(|k| {
+            let t = k as f64 / 20.0;
+            let s5 = 10.0 * t.powi(3) - 15.0 * t.powi(4) + 6.0 * t.powi(5);
+            let a5 = 60.0 * t - 180.0 * t.powi(2) + 120.0 * t.powi(3);
+            let (q, qdd) = (a + (b - a) * s5, (b - a) * a5);
+            ratio * ((i_zz + m * c * c) * qdd + m * g * c * q.cos())
+        })
+        .collect()
+}
+
+/// QTR and QIT of the pendulum by hand: the grid is −1.5…1.5 in 5 points, every pair i < j
+/// is a task; QTR is the largest RMS over tasks, QIT the largest |τ| (one actuator).
+fn pendulum_qtr_qit() -> (f64, f64) {
+    let points: Vec<f64> = (0..5).map(|k| -1.5 + 0.75 * k as f64).collect();
+    let (mut qtr, mut qit) = (0.0f64, 0.0f64);
+    for i in 0..5 {
+        for j in i + 1..5 {
+            let tau = pendulum_motor_torque(points[i], points[j]);
+            let rms = (tau.iter().map(|t| t * t).sum::<f64>() / tau.len() as f64).sqrt();
+            qtr = qtr.max(rms);
+            qit = tau.iter().fold(qit, |q, t| q.max(t.abs()));
+        }
+    }
+    (qtr, qit)
+}
+
+#[test]
+fn evaluate_json_of_the_pendulum_matches_a_hand_calculation() {
+    let out = counterpoise(&["evaluate", "cases/pendulum.json", "--json"]);
+    assert_success(&out);
+    let doc: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let (qtr, qit) = pendulum_qtr_qit();
+    assert!(
+        (num(&doc, "qtr") - qtr).abs() < 1e-9 * qtr,
+        "QTR {} vs {qtr}",
+        doc["qtr"]
+    );
+    assert!(
+        (num(&doc, "qit") - qit).abs() < 1e-9 * qit,
+        "QIT {} vs {qit}",
+        doc["qit"]
+    );
+    assert_eq!(doc["points"], 5);
+    assert_eq!(doc["tasks"], 10);
+    assert_eq!(doc["evaluated"], 10);
+    // one actuator: its critical RMS is QTR, its critical peak QIT
+    assert!((num(&doc["actuators"][0], "crt_rms") - qtr).abs() < 1e-9 * qtr);
+    assert!((num(&doc["actuators"][0], "cpt_peak") - qit).abs() < 1e-9 * qit);
+    assert_eq!(doc["joints"].as_array().unwrap().len(), 1);
+    assert!(num(&doc["joints"][0], "force") > 0.0);
+
+    // Without reactions: the same motor indicators and no joint peaks.
+    let bare = counterpoise(&[
+        "evaluate",
+        "cases/pendulum.json",
+        "--json",
+        "--no-reactions",
+    ]);
+    assert_success(&bare);
+    let bare: serde_json::Value = serde_json::from_str(&stdout(&bare)).unwrap();
+    assert_eq!(bare["qtr"], doc["qtr"]);
+    assert_eq!(bare["qit"], doc["qit"]);
+    assert_eq!(bare["actuators"], doc["actuators"]);
+    assert!(bare["joints"].as_array().unwrap().is_empty());
+
+    // The plain-text form shows the same QTR.
+    let text = counterpoise(&["evaluate", "cases/pendulum.json"]);
+    assert_success(&text);
+    assert!(
+        stdout(&text).contains(&format!("QTR = {qtr:.3} N·m")),
+        "{}",
+        stdout(&text)
+    );
+}
+
+/// Runs `run` on the pendulum into a fresh directory with extra arguments.
+fn run_pendulum(dir: &std::path::Path, name: &str, extra: &[&str]) -> (Output, serde_json::Value) {
+    let out = dir.join(name);
+    let mut args = vec!["run", "cases/pendulum.json", "--out", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let o = counterpoise(&args);
+    assert_success(&o);
+    let doc = results(&out);
+    (o, doc)
+}
+
+fn feasible(doc: &serde_json::Value) -> Vec<&serde_json::Value> {
+    doc["variants"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|v| v["status"] == "feasible")
+        .collect()
+}
+
+#[test]
+fn run_prints_a_summary_of_what_it_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    let (o, doc) = run_pendulum(dir.path(), "out", &[]);
+    let text = stdout(&o);
+    let variants = doc["variants"].as_array().unwrap().len();
+    assert!(
+        text.starts_with(&format!(
+            "pendulum: {variants} variants examined (Dmax = 1)"
+        )),
+        "{text}"
+    );
+    let ranked = feasible(&doc);
+    assert!(!ranked.is_empty());
+    assert!(
+        text.contains(&format!("Ranking (top {}):", ranked.len())),
+        "{text}"
+    );
+    for v in &ranked {
+        let name = format!("SB{}", v["rank"]);
+        assert!(text.contains(&name), "{name} in {text}");
+    }
+    for file in ["results.json", "report.html", "report.md", "ranking.csv"] {
+        let path = dir.path().join("out").join(file);
+        assert!(
+            text.contains(&format!("wrote {}", path.display())),
+            "{file}: {text}"
+        );
+    }
+}
+
+#[test]
+fn minimax_on_one_actuator_ranks_like_rms_star() {
+    // One actuator: RMS* (its RMS in its critical task) and QTR (the largest RMS over tasks)
+    // are the same function of the parameters, so both objectives give the same variants.
+    let dir = tempfile::tempdir().unwrap();
+    let (_, rms) = run_pendulum(dir.path(), "rms", &[]);
+    let (_, minimax) = run_pendulum(dir.path(), "minimax", &["--minimax"]);
+    let (a, b) = (feasible(&rms), feasible(&minimax));
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x["elements"], y["elements"]);
+        let (dx, dy) = (num(x, "dqtr"), num(y, "dqtr"));
+        assert!((dx - dy).abs() < 1e-4 * dx.abs().max(1.0), "{dx} vs {dy}");
+    }
+}
+
+#[test]
+fn usage_errors_exit_with_code_2() {
+    for args in [
+        &["run"][..],
+        &["evaluate", "cases/pendulum.json", "--bogus"],
+        &["evaluate", "cases/pendulum.json", "--task", "0,4"],
+        &[
+            "evaluate",
+            "cases/pendulum.json",
+            "--task",
+            "x",
+            "--series",
+            "s.json",
+        ],
+        &["--jobs", "0", "check", "cases/pendulum.json"],
+        &["run", "cases/pendulum.json", "--resolution", "fine"],
+    ] {
+        let out = counterpoise(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(!stderr(&out).is_empty(), "{args:?} explains itself");
+        assert!(stdout(&out).is_empty(), "{args:?}");
+    }
 }

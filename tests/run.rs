@@ -1,82 +1,132 @@
 //! End-to-end: `counterpoise run` on the palletizer with a reduced task grid, then `report`.
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+use common::{assert_success, counterpoise, num, reduced_palletizer, results, stdout, write_case};
+
+/// Eqs. 17–21 written out here from the paper's definition (a second implementation, not the
+/// report crate's): ΔR = Σ_j γ_Fj·max(ΔF_j, 0) + γ_Mj·max(ΔM_j, 0), γ = reference share; a
+/// joint with zero reference load contributes (X_SB − 0)/Σ X_UB·100, the weighted term's limit.
+fn delta_r(ub: &serde_json::Value, sb: &serde_json::Value) -> f64 {
+    let (ub, sb) = (
+        ub["joints"].as_array().unwrap(),
+        sb["joints"].as_array().unwrap(),
+    );
+    assert_eq!(ub.len(), sb.len());
+    let mut total = 0.0;
+    for key in ["force", "moment"] {
+        let sum: f64 = ub.iter().map(|j| num(j, key)).sum();
+        if sum <= 0.0 {
+            continue;
+        }
+        for (u, s) in ub.iter().zip(sb) {
+            let (u, s) = (num(u, key), num(s, key));
+            total += (s - u).max(0.0) / sum * 100.0;
+        }
+    }
+    total
 }
 
 #[test]
 fn run_writes_every_output_and_report_regenerates_them() {
-    let dir = std::env::temp_dir().join(format!("counterpoise-run-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = tempfile::tempdir().unwrap();
     // the palletizer on a 3 × 3 × 3 grid (351 tasks) with 11 samples per task
-    let text = std::fs::read_to_string(root().join("cases/palletizer.json")).unwrap();
-    let mut case: serde_json::Value = serde_json::from_str(&text).unwrap();
-    // the same corners as the case's 7 × 7 × 7 grid, fewer points
-    let mut grid = case["tasks"]["grid"].clone();
-    for axis in grid.as_object_mut().unwrap().values_mut() {
-        axis[2] = serde_json::json!(3);
-    }
-    case["tasks"]["grid"] = grid;
-    case["tasks"]["samples"] = serde_json::json!(11);
-    let case_path = dir.join("palletizer-small.json");
-    std::fs::write(&case_path, serde_json::to_string(&case).unwrap()).unwrap();
-    let out = dir.join("out");
+    let case = reduced_palletizer(3, 11);
+    let case_path = write_case(dir.path(), "palletizer-small.json", &case);
+    let out = dir.path().join("out");
 
-    let run = Command::new(env!("CARGO_BIN_EXE_counterpoise"))
-        .args([
-            "run",
-            case_path.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let run = counterpoise(&["run", &case_path, "--out", out.to_str().unwrap()]);
+    assert_success(&run);
     for file in ["results.json", "report.html", "report.md", "ranking.csv"] {
         assert!(out.join(file).is_file(), "{file} missing");
+        assert!(
+            stdout(&run).contains(&format!("wrote {}", out.join(file).display())),
+            "stdout names {file}"
+        );
     }
-    let results: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let results = results(&out);
     assert_eq!(results["schema_version"], 1);
     let variants = results["variants"].as_array().unwrap();
     assert_eq!(variants.len(), 406, "paper Eq. A8");
+    let counted: u64 = results["counts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["total"].as_u64().unwrap())
+        .sum();
+    assert_eq!(counted, 406);
+
+    // A second method for the spring-only variants: springs are massless and balance gravity
+    // exactly, so their motor torques are the unbalanced robot's without gravity.
+    let mut no_gravity = case.clone();
+    no_gravity["gravity"] = serde_json::json!([0.0, 0.0, 0.0]);
+    let no_gravity_path = write_case(dir.path(), "no-gravity.json", &no_gravity);
+    let inertial = counterpoise(&["evaluate", &no_gravity_path, "--json", "--no-reactions"]);
+    assert_success(&inertial);
+    let inertial: serde_json::Value = serde_json::from_str(&stdout(&inertial)).unwrap();
+    let ub = &results["unbalanced"];
+    let (qtr_ub, qit_ub) = (num(ub, "qtr"), num(ub, "qit"));
+    let spring_dqtr = (num(&inertial, "qtr") - qtr_ub) / qtr_ub * 100.0;
+    let spring_dqit = (num(&inertial, "qit") - qit_ub) / qit_ub * 100.0;
+
     let feasible: Vec<_> = variants
         .iter()
         .filter(|v| v["status"] == "feasible")
         .collect();
-    assert!(!feasible.is_empty());
-    for v in &feasible {
-        for field in ["dqtr", "dqit", "dr", "rank", "class_rank"] {
-            assert!(!v[field].is_null(), "{field} missing in {v}");
-        }
-        assert!(v["verification_residual"].as_f64().unwrap() <= 1e-9);
-        // balanced: motor torque is inertial only, so the balanced QTR is below the unbalanced
-        assert!(v["dqtr"].as_f64().unwrap() < 0.0);
-    }
-    // spring-only variants are dynamically identical: same ΔQTR and ΔQIT
     let springs: Vec<_> = feasible
         .iter()
         .filter(|v| v["class"] == "springs")
         .collect();
-    for pair in springs.windows(2) {
-        let d = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
-        assert!((d(pair[0], "dqtr") - d(pair[1], "dqtr")).abs() < 1e-6);
-        assert!((d(pair[0], "dqit") - d(pair[1], "dqit")).abs() < 1e-6);
+    assert!(feasible.len() >= 2 && !springs.is_empty());
+    for v in &feasible {
+        for field in ["dqtr", "dqit", "dr", "rank", "class_rank"] {
+            assert!(!v[field].is_null(), "{field} missing in {v}");
+        }
+        assert!(num(v, "verification_residual") <= 1e-9);
+        // Eqs. 15, 16 and 17–21 from the stored indicators
+        let ev = &v["evaluation"];
+        let dqtr = (num(ev, "qtr") - qtr_ub) / qtr_ub * 100.0;
+        let dqit = (num(ev, "qit") - qit_ub) / qit_ub * 100.0;
+        assert!((num(v, "dqtr") - dqtr).abs() < 1e-9, "{dqtr} in {v}");
+        assert!((num(v, "dqit") - dqit).abs() < 1e-9, "{dqit} in {v}");
+        let dr = delta_r(ub, ev);
+        assert!(
+            (num(v, "dr") - dr).abs() < 1e-9 * (1.0 + dr),
+            "ΔR {dr} in {v}"
+        );
+        // balanced: the motor torque is inertial only, below the unbalanced robot's
+        assert!(num(v, "dqtr") < 0.0);
     }
-    let ranks: Vec<u64> = feasible
+    for v in &springs {
+        assert!(
+            (num(v, "dqtr") - spring_dqtr).abs() < 1e-6,
+            "ΔQTR {} vs gravity-free {spring_dqtr}",
+            v["dqtr"]
+        );
+        assert!((num(v, "dqit") - spring_dqit).abs() < 1e-6);
+    }
+
+    // Ranks are 1..n; the lexicographic order means no variant more than one resolution
+    // (0.01 pp) better in ΔQTR than the next-ranked one per tie-chain step follows it.
+    let mut by_rank: Vec<_> = feasible.iter().collect();
+    by_rank.sort_by_key(|v| v["rank"].as_u64().unwrap());
+    let ranks: Vec<u64> = by_rank
         .iter()
         .map(|v| v["rank"].as_u64().unwrap())
         .collect();
-    let mut sorted = ranks.clone();
-    sorted.sort_unstable();
-    assert_eq!(sorted, (1..=feasible.len() as u64).collect::<Vec<_>>());
+    assert_eq!(ranks, (1..=feasible.len() as u64).collect::<Vec<_>>());
+    let best_dqtr = feasible
+        .iter()
+        .map(|v| num(v, "dqtr"))
+        .fold(f64::INFINITY, f64::min);
+    assert!(num(by_rank[0], "dqtr") < best_dqtr + 0.01 * feasible.len() as f64);
+    let csv = std::fs::read_to_string(out.join("ranking.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        1 + feasible.len(),
+        "header and one row each"
+    );
+
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains("<svg"));
     assert!(
@@ -85,18 +135,107 @@ fn run_writes_every_output_and_report_regenerates_them() {
     );
 
     std::fs::remove_file(out.join("report.html")).unwrap();
-    let report = Command::new(env!("CARGO_BIN_EXE_counterpoise"))
-        .args(["report", out.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        report.status.success(),
-        "{}",
-        String::from_utf8_lossy(&report.stderr)
-    );
+    let report = counterpoise(&["report", out.to_str().unwrap()]);
+    assert_success(&report);
     assert_eq!(
         std::fs::read_to_string(out.join("report.html")).unwrap(),
         html
     );
-    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A ranked variant: rank, ΔQTR, ΔR, class and element labels (`m4 + K43`).
+#[derive(Debug, PartialEq)]
+struct Ranked {
+    rank: u64,
+    dqtr: f64,
+    dr: f64,
+    class: String,
+    label: String,
+}
+
+/// Feasible variants of a results document, best first.
+fn ranked(doc: &serde_json::Value) -> Vec<Ranked> {
+    let mut v: Vec<_> = doc["variants"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|v| v["status"] == "feasible")
+        .map(|v| Ranked {
+            rank: v["rank"].as_u64().unwrap(),
+            dqtr: num(v, "dqtr"),
+            dr: num(v, "dr"),
+            class: v["class"].as_str().unwrap().to_string(),
+            label: v["elements"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|e| e["label"].as_str().unwrap())
+                .collect::<Vec<_>>()
+                .join(" + "),
+        })
+        .collect();
+    v.sort_by_key(|x| x.rank);
+    v
+}
+
+/// `run` with one and with two worker threads gives the same results.json apart from the
+/// run's date, timings and thread count, and the same ranking.csv; `--resolution` changes
+/// which differences count in the ranking.
+#[test]
+fn run_is_identical_with_one_and_two_threads_and_resolution_decides_ties() {
+    let dir = tempfile::tempdir().unwrap();
+    // 2 × 2 × 2 grid (28 tasks), 11 samples: seconds, not minutes
+    let case_path = write_case(dir.path(), "tiny.json", &reduced_palletizer(2, 11));
+    // `global` goes before the subcommand, `options` after it
+    let run = |name: &str, global: &[&str], options: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = global.to_vec();
+        args.extend(["run", &case_path, "--out", out.to_str().unwrap()]);
+        args.extend_from_slice(options);
+        let o = counterpoise(&args);
+        assert_success(&o);
+        let csv = std::fs::read_to_string(out.join("ranking.csv")).unwrap();
+        (results(&out), csv)
+    };
+    let strip = |mut doc: serde_json::Value, jobs: u64| {
+        let meta = doc["metadata"].as_object_mut().unwrap();
+        assert_eq!(meta["jobs"], serde_json::json!(jobs));
+        for volatile in ["jobs", "date", "timings"] {
+            meta.remove(volatile);
+        }
+        doc
+    };
+    let (one, one_csv) = run("one", &["--jobs", "1"], &[]);
+    let (two, two_csv) = run("two", &["--jobs", "2"], &[]);
+    let one = strip(one, 1);
+    assert_eq!(one, strip(two, 2));
+    assert_eq!(one_csv, two_csv);
+
+    // Default resolution (0.01 pp): ΔQTR decides first, so it never improves by more than the
+    // resolution from one rank to the next. Spring-only variants have identical motor torques
+    // (the robot's without gravity), so they tie on ΔQTR and ΔQIT and ΔR orders them.
+    let fine = ranked(&one);
+    assert!(fine.len() >= 2, "{fine:?}");
+    for w in fine.windows(2) {
+        assert!(w[1].dqtr >= w[0].dqtr - 0.01, "ΔQTR decides: {fine:?}");
+    }
+    let springs: Vec<&Ranked> = fine.iter().filter(|v| v.class == "springs").collect();
+    assert!(springs.len() >= 2);
+    for w in springs.windows(2) {
+        assert!(
+            w[0].dr <= w[1].dr + 0.01,
+            "ΔR orders the springs: {springs:?}"
+        );
+    }
+    // At 10⁶ pp every criterion ties (consecutive values are chained), so the element labels
+    // alone give the order.
+    let (coarse, _) = run("coarse", &[], &["--resolution", "1e6"]);
+    let coarse = ranked(&coarse);
+    for w in coarse.windows(2) {
+        assert!(w[0].label < w[1].label, "labels decide: {coarse:?}");
+    }
+    assert_ne!(
+        fine, coarse,
+        "the resolution changes the order on this case"
+    );
 }

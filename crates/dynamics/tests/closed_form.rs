@@ -207,3 +207,56 @@ fn spring_generalized_force_is_the_gradient_of_its_energy() {
         }
     }
 }
+
+/// A cylindrical counterweight with radius/thickness ratio τ = 0.5 (every case file uses τ = 1,
+/// where τ and τ² cannot be told apart). From the volume `m/ρ = πR²t = πR³/τ` by hand,
+/// `R = (τ m / (ρ π))^(1/3)`, `J_zz = m R²/2` about the cylinder's axis (the normal of the xy
+/// plane) and `J_⊥ = m (3R² + t²)/12` with `t = R/τ`. Balanced (m·r = −m_rod·c), the pendulum's
+/// torque is inertial only: `(I_rod,O + m r² + J_zz) θ̈`.
+#[test]
+fn cylinder_counterweight_with_tau_not_one() {
+    let (tau, rho, m, r) = (0.5, 7850.0, 4.0, -0.25);
+    let radius = (tau * m / (rho * std::f64::consts::PI)).cbrt();
+    let thickness = radius / tau;
+    let j_axis = 0.5 * m * radius * radius;
+    let j_across = m * (3.0 * radius * radius + thickness * thickness) / 12.0;
+
+    let j = counterpoise_dynamics::params::cylinder_inertia(m, tau, rho, 0);
+    assert_close(j[(0, 0)], j_axis, 1e-15, "J along the axis");
+    assert_close(j[(1, 1)], j_across, 1e-15, "J across");
+    assert_close(j[(2, 2)], j_across, 1e-15, "J across");
+    assert_eq!(j[(0, 1)], 0.0);
+
+    let mut json: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(format!(
+            "{}/../../cases/pendulum.json",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    json["balancing"]["counterweights"]["shape"] =
+        serde_json::json!({ "cylinder": { "radius_to_thickness": tau, "density": rho } });
+    let model = common::case_from_text(&json.to_string());
+    let variant = Variant {
+        counterweights: vec![Counterweight {
+            body: 0,
+            mass: m,
+            position: [r, 0.0, 0.0],
+        }],
+        springs: vec![],
+    };
+    let params = ParameterSet::from_variants(&model, &[variant]).unwrap();
+    let s = task_series_with(&model, &params, 0, 0, 4, Some(21)).unwrap();
+    let inertia = 0.1667 + 2.0 * 0.25 + m * r * r + j_axis;
+    for (k, &t) in s.t.iter().enumerate() {
+        let (_, _, thdd) = quintic(-1.5, 1.5, 1.0, t);
+        let expected = inertia * thdd;
+        assert_close(
+            s.actuator_force[k][0],
+            expected,
+            1e-9 * (1.0 + expected.abs()),
+            "balanced torque with a τ = 0.5 cylinder",
+        );
+    }
+}

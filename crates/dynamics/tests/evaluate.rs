@@ -24,28 +24,69 @@ fn coarse_palletizer() -> Model {
 #[test]
 fn unreachable_tasks_are_excluded_not_fatal() {
     let mut model = coarse_palletizer();
-    // ρ2 up to 0.6 m: beyond the pantograph's reach (ρ2 ≤ δ3 + δ1 + δ4 = 0.35 m).
+    // ρ2 ∈ {0, 0.3, 0.6} m, ρ3 ∈ {1.03, 1.2, 1.37} m. Points are numbered with M1 slowest, so
+    // point i has ρ2 = 0.3·(i / 3 % 3) and ρ3 index i % 3. Which points the arm reaches within
+    // its coordinate ranges is decided by the two-link inverse kinematics below, by hand:
+    // 0.6 is beyond reach for every ρ3, and (0.3, 1.37) needs θ3 = −0.017 < 0. That leaves 15
+    // of 27 points; every task touching one of the other 12 fails and every other task runs:
+    // 351 − C(15, 2) = 351 − 105 = 246 excluded tasks.
     model.tasks.as_mut().unwrap().grid[1] = GridAxis {
         from: 0.0,
         to: 0.6,
         n: 3,
     };
+    let unreachable = |point: usize| {
+        let rho2 = 0.3 * (point / 3 % 3) as f64;
+        let rho3 = [1.03, 1.2, 1.37][point % 3];
+        !pantograph_reaches(rho2, rho3)
+    };
+    assert_eq!((0..27).filter(|&p| unreachable(p)).count(), 12);
     let report = evaluate(&model, &EvaluateOptions::default()).unwrap();
-    assert!(report.excluded.count > 0);
-    assert!(report.evaluated > 0);
-    assert_eq!(report.evaluated + report.excluded.count, report.tasks);
+    assert_eq!(report.tasks, 351);
+    assert_eq!(
+        report.excluded.count, 246,
+        "{:?}",
+        report.excluded.by_reason
+    );
+    assert_eq!(report.evaluated, 105);
+    assert_eq!(report.excluded.by_reason.values().sum::<usize>(), 246);
     assert!(report.indicators.qtr.is_finite() && report.indicators.qit.is_finite());
     for j in &report.indicators.joints {
         assert!(j.force.is_finite() && j.moment.is_finite());
     }
-    // every excluded task touches a point with ρ2 = 0.6 (middle grid index 2)
+    assert_eq!(
+        report.excluded.examples.len(),
+        counterpoise_dynamics::evaluate::MAX_FAILURE_EXAMPLES
+    );
     for f in &report.excluded.examples {
         let (i, j) = report_pair(&model, f.task);
         assert!(
-            i / 3 % 3 >= 1 || j / 3 % 3 >= 1,
+            unreachable(i) || unreachable(j),
             "task {i}->{j} excluded: {:?}",
             f.reason
         );
+    }
+    // Task by task: excluded exactly when an end point is unreachable.
+    let grid = evaluate_grid(
+        &model,
+        &ParameterSet::unbalanced(&model),
+        &EvaluateOptions {
+            reactions: false,
+            ..EvaluateOptions::default()
+        },
+    )
+    .unwrap();
+    for w in 0..grid.tasks.len() {
+        let (i, j) = grid.tasks.pair(w);
+        assert_eq!(
+            grid.stats(w, 0).is_none(),
+            unreachable(i) || unreachable(j),
+            "task {i}->{j}"
+        );
+    }
+    // The critical tasks are among those that ran.
+    for a in &report.indicators.actuators {
+        assert!(!unreachable(a.crt[0]) && !unreachable(a.crt[1]));
     }
     let json = serde_json::to_value(&report).unwrap();
     assert!(
@@ -54,6 +95,25 @@ fn unreachable_tasks_are_excluded_not_fatal() {
             .unwrap()
             .is_empty()
     );
+}
+
+/// Whether the palletizer's arm reaches the actuator values `(ρ2, ρ3)` with θ2 ∈ [−0.1, 1.75]
+/// and θ3 ∈ [0, 2.1] (the case's ranges). With `x = ρ2 − δ3 = δ1 cos θ2 + δ4 cos θ3` and
+/// `y = ρ3 − δ2 = δ1 sin θ2 − δ4 sin θ3` it is a two-link arm in (θ2, −θ3): the law of cosines
+/// gives θ2 + θ3 = ±acos((x² + y² − δ1² − δ4²)/(2 δ1 δ4)), then θ2 follows from atan2.
+fn pantograph_reaches(rho2: f64, rho3: f64) -> bool {
+    let (d1, d2, d3, d4) = (0.3, 1.2, -0.2, 0.25);
+    let (x, y) = (rho2 - d3, rho3 - d2);
+    let c = (x * x + y * y - d1 * d1 - d4 * d4) / (2.0 * d1 * d4);
+    if c.abs() > 1.0 {
+        return false;
+    }
+    [1.0, -1.0].into_iter().any(|branch: f64| {
+        let sum = branch * c.acos(); // θ2 − (−θ3)
+        let th2 = y.atan2(x) - (-d4 * sum.sin()).atan2(d1 + d4 * sum.cos());
+        let th3 = sum - th2;
+        (-0.1..=1.75).contains(&th2) && (0.0..=2.1).contains(&th3)
+    })
 }
 
 fn report_pair(model: &Model, task: usize) -> (usize, usize) {

@@ -2,14 +2,18 @@
 //! both links. Balance fixes `m2·r2 = −(M2 c2 + m_tool L2)` and couples the first link's to the
 //! second counterweight's mass, `m1·r1 = −(M1 c1 + (M2 + m_tool + m2) L1)`; the first mass is
 //! fixed by an override, so the family is one-dimensional in `m2`. The reference is a fine scan
-//! over `m2` of the true objective, evaluated with the dynamics crate directly from these
-//! formulas (not through this crate).
+//! over `m2` of the true objective: the parameters come from these formulas, the motor torques
+//! from the dynamics crate (checked against Lagrange's equations of this arm in
+//! `crates/dynamics/tests/closed_form.rs`), and RMS* — the root mean square over the actuators
+//! of each one's RMS torque in its critical task — is computed here; nothing in the scan goes
+//! through this crate.
 
 mod common;
 
+use counterpoise_dynamics::Indicators;
 use counterpoise_dynamics::params::{Counterweight, ParameterSet, Variant};
 use counterpoise_dynamics::{EvaluateOptions, evaluate_grid};
-use counterpoise_optimise::{OptimiseOptions, OptimisedStatus, objective_of};
+use counterpoise_optimise::{Objective, OptimiseOptions, OptimisedStatus};
 
 const M1: f64 = 4.0;
 const C1: f64 = 0.4;
@@ -54,7 +58,25 @@ fn variant(m2: f64) -> Variant {
     }
 }
 
-fn scan(model: &counterpoise_model::Model, lo: f64, hi: f64, n: usize) -> Vec<(f64, f64, f64)> {
+/// RMS* = sqrt(Σ_n RMS_n² / N), each actuator's RMS taken in its own critical task.
+fn rms_star(ind: &Indicators) -> f64 {
+    let n = ind.actuators.len() as f64;
+    (ind.actuators.iter().map(|a| a.crt_rms.powi(2)).sum::<f64>() / n).sqrt()
+}
+
+/// QTR = max over tasks of Σ_n RMS_n (Eq. 1), as the dynamics crate reduces it.
+fn qtr(ind: &Indicators) -> f64 {
+    ind.qtr
+}
+
+/// `(m2, objective, peak of M1)` at `n + 1` masses evenly spread over `[lo, hi]`.
+fn scan(
+    model: &counterpoise_model::Model,
+    lo: f64,
+    hi: f64,
+    n: usize,
+    objective: fn(&Indicators) -> f64,
+) -> Vec<(f64, f64, f64)> {
     let masses: Vec<f64> = (0..=n)
         .map(|k| lo + (hi - lo) * k as f64 / n as f64)
         .collect();
@@ -74,11 +96,7 @@ fn scan(model: &counterpoise_model::Model, lo: f64, hi: f64, n: usize) -> Vec<(f
         .zip(&grid.indicators)
         .map(|(&m, ind)| {
             let peak = ind.actuators[0].cpt_peak;
-            (
-                m,
-                objective_of(ind, counterpoise_optimise::Objective::RmsStar),
-                peak,
-            )
+            (m, objective(ind), peak)
         })
         .collect()
 }
@@ -98,11 +116,12 @@ fn fine_scan(
     lo: f64,
     hi: f64,
     limit: Option<f64>,
+    objective: fn(&Indicators) -> f64,
 ) -> (f64, f64) {
-    let coarse = scan(model, lo, hi, 200);
+    let coarse = scan(model, lo, hi, 200, objective);
     let (m, _) = best_of(&coarse, limit);
     let h = (hi - lo) / 200.0;
-    let fine = scan(model, (m - h).max(lo), (m + h).min(hi), 400);
+    let fine = scan(model, (m - h).max(lo), (m + h).min(hi), 400, objective);
     best_of(&fine, limit)
 }
 
@@ -126,7 +145,7 @@ fn one_free_mass_matches_a_fine_scan() {
         .unwrap()
         .mass;
     let lo = 0.5_f64.max((M2 * C2 + TOOL * L2) / 2.0);
-    let (m_star, f_star) = fine_scan(&model, lo, 40.0, None);
+    let (m_star, f_star) = fine_scan(&model, lo, 40.0, None, rms_star);
     let obj = v.objective.unwrap();
     assert!(
         (obj - f_star).abs() <= 1e-4 * f_star,
@@ -147,7 +166,7 @@ fn active_peak_limit_is_respected() {
     let json = case([0.5, 40.0], None);
     let model = common::model(&json);
     let lo = 0.5_f64.max((M2 * C2 + TOOL * L2) / 2.0);
-    let points = scan(&model, lo, 40.0, 400);
+    let points = scan(&model, lo, 40.0, 400, rms_star);
     let (m_free, _) = best_of(&points, None);
     let peak_at_free = points.iter().find(|p| p.0 == m_free).unwrap().2;
     let min_peak = points.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
@@ -170,10 +189,57 @@ fn active_peak_limit_is_respected() {
         peak >= limit * (1.0 - 1e-4),
         "limit should be active: peak {peak}, limit {limit}"
     );
-    let (_, f_star) = fine_scan(&model, lo, 40.0, Some(limit));
+    let (_, f_star) = fine_scan(&model, lo, 40.0, Some(limit), rms_star);
+    let (_, f_free) = fine_scan(&model, lo, 40.0, None, rms_star);
     let obj = v.objective.unwrap();
     assert!(
-        obj <= f_star * (1.0 + 1e-4),
+        (obj - f_star).abs() <= 1e-4 * f_star,
         "objective {obj} vs constrained scan {f_star}"
     );
+    // The limit costs objective: the constrained optimum is above the free one by more than
+    // the tolerance of the comparisons (about 4·10⁻⁴ here).
+    assert!(
+        f_star > f_free * (1.0 + 1e-4),
+        "constrained {f_star} vs free {f_free}"
+    );
+    assert!(
+        obj > f_free * (1.0 + 1e-4),
+        "objective {obj} vs free {f_free}"
+    );
+}
+
+#[test]
+fn minimax_with_two_actuators_matches_a_qtr_scan() {
+    // Two actuators: QTR (the largest over tasks of M1's plus M2's RMS, Eq. 1) and RMS* (each
+    // actuator at its own critical task) are different functions of m2, so the minimax
+    // objective has its own optimum; the reference is a scan of QTR.
+    let json = case([0.5, 40.0], None);
+    let model = common::model(&json);
+    let options = OptimiseOptions {
+        objective: Objective::Minimax,
+        ..OptimiseOptions::default()
+    };
+    let (_, results) = common::optimise(&model, &[&["m1", "m2"]], &options);
+    let v = &results[0];
+    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    let lo = 0.5_f64.max((M2 * C2 + TOOL * L2) / 2.0);
+    let (m_star, q_star) = fine_scan(&model, lo, 40.0, None, qtr);
+    let obj = v.objective.unwrap();
+    let m2 = v
+        .counterweights
+        .iter()
+        .find(|c| c.label == "m2")
+        .unwrap()
+        .mass;
+    assert!(
+        (obj - q_star).abs() <= 1e-4 * q_star,
+        "objective {obj} vs QTR scan {q_star} (m2 {m2} vs {m_star})"
+    );
+    // The returned indicators are those of the returned parameters: QTR is the objective.
+    let ind = v.indicators.as_ref().unwrap();
+    assert!((ind.qtr - obj).abs() <= 1e-9 * obj);
+    // At the RMS* optimum QTR is no better than at the minimax one.
+    let (m_rms, _) = fine_scan(&model, lo, 40.0, None, rms_star);
+    let at_rms = scan(&model, m_rms, m_rms, 1, qtr)[0].1;
+    assert!(at_rms >= q_star * (1.0 - 1e-9), "{at_rms} vs {q_star}");
 }

@@ -594,7 +594,52 @@ fn terminal_summary() {
             .any(|l| l.trim_start().starts_with("Springs only") && l.contains("SB1")),
         "{s}"
     );
-    // Columns line up: every ranking row has the same length up to the last column.
-    let rows: Vec<&str> = s.lines().filter(|l| l.contains(" SB")).collect();
-    assert!(rows.len() >= 5);
+    // The ranking section lists the five feasible variants, once each, in rank order.
+    let ranking: Vec<&str> = s
+        .lines()
+        .skip_while(|l| !l.starts_with("Ranking (top 5):"))
+        .skip(1)
+        .collect();
+    assert_eq!(ranking.len(), 1 + 5, "header and five rows: {s}");
+    let mut ranked: Vec<(usize, String)> = r
+        .variants
+        .iter()
+        .filter_map(|v| v.rank.map(|k| (k, v.label())))
+        .collect();
+    ranked.sort();
+    assert_eq!(ranked.len(), 5);
+    for (line, (rank, label)) in ranking[1..].iter().zip(&ranked) {
+        assert!(
+            line.contains(&format!("SB{rank}")) && line.contains(label.as_str()),
+            "SB{rank} {label} in `{line}`"
+        );
+    }
+    // Columns line up: the last column is numeric (right-aligned), so every line of the
+    // section has the same width.
+    let widths: Vec<usize> = ranking.iter().map(|l| l.chars().count()).collect();
+    assert!(widths.iter().all(|&w| w == widths[0]), "{widths:?}\n{s}");
+}
+
+#[test]
+fn aligned_columns_match_a_hand_layout() {
+    use counterpoise_report::tables::{Cell, Table};
+    // Widths by hand: "Variant" 7 ≥ "K42 + K43" 9 → 9; "ΔQTR" 4 ≤ "−63.20" 6 → 6.
+    // Text is left-aligned, numbers right-aligned, columns joined by two spaces, lines indented
+    // by two and trimmed at the end.
+    let t = Table {
+        header: vec!["Variant".into(), "ΔQTR".into(), "Note".into()],
+        rows: vec![
+            vec![Cell::text("m4"), Cell::num("−5.00"), Cell::text("")],
+            vec![
+                Cell::text("K42 + K43"),
+                Cell::num("−63.20"),
+                Cell::text("tie"),
+            ],
+        ],
+        group_starts: vec![false, false],
+    };
+    assert_eq!(
+        counterpoise_report::text::aligned(&t),
+        "  Variant      ΔQTR  Note\n  m4          −5.00\n  K42 + K43  −63.20  tie\n"
+    );
 }

@@ -92,15 +92,42 @@ proptest! {
     }
 }
 
+/// `(sin a + sin b)⁴` expanded by hand with `sin² = 1 − cos²`:
+/// `s_a⁴ = 1 − 2c_a² + c_a⁴`, `4 s_a³ s_b = 4 s_a s_b − 4 c_a² s_a s_b`,
+/// `6 s_a² s_b² = 6 − 6c_a² − 6c_b² + 6 c_a² c_b²`, and symmetrically, so
+/// `8 − 8c_a² − 8c_b² + c_a⁴ + c_b⁴ + 6 c_a² c_b² + 8 s_a s_b − 4 c_a² s_a s_b − 4 c_b² s_a s_b`.
+/// The canonical form must hold exactly these nine monomials (no sine squared survives).
 #[test]
 fn sin_squared_never_survives_a_product() {
     let p = (&TrigPoly::sin(0) + &TrigPoly::sin(1)).pow(4);
-    for (m, _) in p.terms() {
-        // every sine appears at most once: sin² was rewritten as 1 − cos²
-        let _: &Monomial = m;
-        assert!(m.degree() <= 8);
+    // (cos a power, sin a, cos b power, sin b) → coefficient
+    let expected: std::collections::BTreeMap<(u8, bool, u8, bool), f64> = [
+        ((0, false, 0, false), 8.0),
+        ((2, false, 0, false), -8.0),
+        ((0, false, 2, false), -8.0),
+        ((4, false, 0, false), 1.0),
+        ((0, false, 4, false), 1.0),
+        ((2, false, 2, false), 6.0),
+        ((0, true, 0, true), 8.0),
+        ((2, true, 0, true), -4.0),
+        ((0, true, 2, true), -4.0),
+    ]
+    .into_iter()
+    .collect();
+    let mut actual = std::collections::BTreeMap::new();
+    for (m, c) in p.terms() {
+        let m: &Monomial = m;
+        assert!(m.variables().all(|v| v < 2), "{m:?}");
+        if c.abs() > 1e-12 {
+            actual.insert((m.power(0), m.has_sine(0), m.power(1), m.has_sine(1)), c);
+        }
     }
-    let expected = |a: f64, b: f64| (a.sin() + b.sin()).powi(4);
+    assert_eq!(actual.len(), expected.len(), "{actual:?}");
+    for (key, c) in &expected {
+        let got = actual.get(key).copied().unwrap_or(f64::NAN);
+        assert!((got - c).abs() < 1e-12, "{key:?}: {got} vs {c}");
+    }
     let q = [0.3, 2.1, 0.0];
-    assert!(close(p.eval(&at(&q)), expected(0.3, 2.1), 1e-13));
+    let direct = (0.3f64.sin() + 2.1f64.sin()).powi(4);
+    assert!(close(p.eval(&at(&q)), direct, 1e-13));
 }
