@@ -551,3 +551,88 @@ fn element_ref(
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::realize::CounterweightParams;
+    use counterpoise_symbolic::{PolyMat3, PolyVec3, TrigPoly, VarKind};
+
+    /// A rod of mass 2 kg with its centre 0.5 m out, hinged about z under gravity −y:
+    /// `V = 2·9.81·0.5·sin θ`; one counterweight on it.
+    fn rod() -> MechanismEnergy {
+        let rotation = PolyMat3::rot_z(&counterpoise_symbolic::LinearAngle::coordinate(0));
+        MechanismEnergy {
+            kinds: vec![VarKind::Angle],
+            ranges: vec![(-3.0, 3.0)],
+            gravity: [0.0, -9.81, 0.0],
+            bodies: vec![crate::energy::BodyFrame {
+                name: "rod".into(),
+                rotation,
+                origin: PolyVec3::zero(),
+            }],
+            unbalanced: TrigPoly::sin(0).scale(9.81),
+            exact: Err("built by hand".into()),
+        }
+    }
+
+    fn fresh(energy: &MechanismEnergy) -> VariantResult {
+        let catalogue = Catalogue::build(
+            energy,
+            &crate::element::CatalogueOptions {
+                counterweight_bodies: vec![0],
+                counterweight_plane: Some(crate::Plane::Xy),
+                ..Default::default()
+            },
+        );
+        new_result(energy, &[(0, &catalogue.entries[0])])
+    }
+
+    #[test]
+    fn a_witness_that_fails_verification_is_undecided_not_balanced() {
+        let energy = rod();
+        let checks = VerificationSet::new(&energy);
+        // m·r = −1 kg·m along x balances the rod; −0.9 leaves 10 % of the energy swing.
+        for (moment, status) in [(-1.0, Status::Balanced), (-0.9, Status::Undecided)] {
+            let mut result = fresh(&energy);
+            let witness = Witness {
+                counterweights: vec![CounterweightParams {
+                    entry: 0,
+                    body: 0,
+                    mass: 2.0,
+                    offset: [moment / 2.0, 0.0, 0.0],
+                }],
+                springs: Vec::new(),
+            };
+            accept_witness(&checks, witness, &mut result);
+            assert_eq!(result.status, status, "{moment}");
+            assert!(result.verification.is_some());
+            if status == Status::Undecided {
+                // The spread is 0.1 of the unbalanced one.
+                let residual = result.verification.unwrap().residual;
+                assert!((residual - 0.1).abs() < 1e-9, "{residual}");
+                assert!(result.reason.unwrap().contains("failed verification"));
+            }
+        }
+    }
+
+    #[test]
+    fn an_idle_element_makes_a_verified_variant_degenerate() {
+        let energy = rod();
+        let checks = VerificationSet::new(&energy);
+        let mut result = fresh(&energy);
+        result.idle.push("m1".into());
+        let witness = Witness {
+            counterweights: vec![CounterweightParams {
+                entry: 0,
+                body: 0,
+                mass: 2.0,
+                offset: [-0.5, 0.0, 0.0],
+            }],
+            springs: Vec::new(),
+        };
+        accept_witness(&checks, witness, &mut result);
+        assert_eq!(result.status, Status::Degenerate);
+        assert!(result.reason.unwrap().starts_with("m1 can only idle"));
+    }
+}

@@ -353,3 +353,35 @@ fn rotated_column_takes_the_right_path_and_keeps_the_verdicts() {
     let reason = mechanism_energy(&model_of(&case)).exact.unwrap_err();
     assert!(reason.starts_with("bodies[0].pose[0].rot_y"), "{reason}");
 }
+
+/// A counterweight on the column cannot change the energy: the column turns about the vertical
+/// axis, so every point on it keeps its height (checked here with the model's kinematics). It is
+/// flagged redundant, and the variant balances as m4 alone does.
+#[test]
+fn a_counterweight_on_the_column_is_redundant() {
+    let model = model_of(&palletizer_json());
+    let kinematics = Kinematics::new(&model);
+    let column = model.body_index("column").unwrap();
+    let mut rng = SplitMix64::new(11);
+    let point = Vector3::new(0.37, -0.21, 0.0);
+    let heights: Vec<f64> = (0..50)
+        .map(|_| {
+            let q = DVector::from_iterator(
+                model.dof(),
+                model
+                    .coordinates
+                    .iter()
+                    .map(|c| rng.uniform(c.range[0], c.range[1])),
+            );
+            let pose = kinematics.body_pose(column, &q);
+            (pose.position + pose.rotation * point).y
+        })
+        .collect();
+    assert!(heights.iter().all(|h| (h - heights[0]).abs() < 1e-12));
+    let report = run(&model, 2);
+    let v = find(&report, &["m1", "m4"]);
+    assert_eq!(v.status, Status::Balanced);
+    assert_eq!(v.redundant, vec!["m1".to_string()]);
+    assert_eq!(find(&report, &["m4"]).relations[0], v.relations[0]);
+    assert_eq!(find(&report, &["m1"]).status, Status::Infeasible);
+}
