@@ -1,6 +1,6 @@
 //! The catalogue of balancing elements and their lifted energy basis.
 //!
-//! Each element's potential energy is linear in its *lifted* parameters (DESIGN §3):
+//! Each element's potential energy is linear in its *lifted* parameters (docs/design.md §3):
 //!
 //! - counterweight on body i, mass m at r: `V = −m g·p_i − g·R_i μ` with `μ = m r`;
 //! - zero-free-length spring of stiffness K from anchor a on body i to anchor b on body s (or the

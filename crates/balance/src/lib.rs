@@ -1,4 +1,4 @@
-//! Exact static balancing search (DESIGN §2 Phase 2, §3; paper Eqs. 9–10, A3–A8).
+//! Exact static balancing search (docs/design.md §2 Phase 2, §3; paper Eqs. 9–10, A3–A8).
 //!
 //! Given a mechanism's symbolic body poses and its unbalanced potential energy, find every set of
 //! at most `Dmax` counterweights and zero-free-length springs that makes the total potential

@@ -1,4 +1,4 @@
-//! Exact balance as linear algebra: `A_S x = −b` per variant (DESIGN §3, paper Eqs. 10, A3–A4).
+//! Exact balance as linear algebra: `A_S x = −b` per variant (docs/design.md §3, paper Eqs. 10, A3–A4).
 //!
 //! The potential energy is constant iff every non-constant coefficient of its canonical
 //! trigonometric-polynomial form vanishes. Rows of `A` are the non-constant basis monomials, its

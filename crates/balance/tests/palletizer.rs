@@ -1,4 +1,4 @@
-//! The balance search on the reference palletizer (shared/cases/palletizer.md, paper Sec. 3).
+//! The balance search on the reference palletizer (docs/palletizer.md, paper Sec. 3).
 
 use std::path::PathBuf;
 

@@ -1,6 +1,6 @@
 //! Parameter vectors: the lifted, linear parameters of every body and spring.
 //!
-//! Motor torques and joint reactions are linear in these (DESIGN §3), so a mechanism variant
+//! Motor torques and joint reactions are linear in these (docs/design.md §3), so a mechanism variant
 //! is just a column of numbers and many variants are evaluated together as a matrix `Π`.
 //!
 //! Per body (10): `π = (m, h = m·c (body frame), I_o)` with `I_o` the inertia about the body

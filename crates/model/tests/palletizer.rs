@@ -1,4 +1,4 @@
-//! The reference palletizer (shared/cases/palletizer.md): the model built from
+//! The reference palletizer (docs/palletizer.md): the model built from
 //! `cases/palletizer.json` must reproduce the closed forms of the paper's Eqs. 22–26 and the
 //! unbalanced potential energy, derived here by hand from the geometry and member tables.
 

@@ -1,4 +1,4 @@
-//! Phase 3 of counterpoise (DESIGN §2, §7; Martini et al. 2019, Sec. 2.3 and 3.2–3.3): the
+//! Phase 3 of counterpoise (docs/design.md §2, §7; Martini et al. 2019, Sec. 2.3 and 3.2–3.3): the
 //! ranking indicators, the rankings, the versioned results document and the reports.
 //!
 //! Data flow: the `run` command fills a [`RunResults`] (plain serde types, independent of the
