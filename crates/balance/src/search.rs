@@ -413,27 +413,23 @@ fn fixed_anchor_equations(
             let values: Vec<String> = v.iter().map(crate::exact::exact_text).collect();
             format!("{}'s anchor {side} = ({})", entry.label, values.join(", "))
         };
-        let one = Rational::from_integer(1.into());
-        if let Some(a0) = solution.proportional_to(start, alpha..alpha + na) {
-            // W_ij − a0_i β_j = 0
+        // W_ij − (fixed factor)·(free factor) = 0 for every component.
+        let mut push_rows = |fixed: &[Rational], free_start: usize, a_fixed: bool| {
             for i in 0..na {
                 for j in 0..nb {
                     let mut row = vec![Rational::from_integer(0.into()); n];
-                    row[w + i * nb + j] = one.clone();
-                    row[beta + j] = -a0[i].clone();
+                    row[w + i * nb + j] = Rational::from_integer(1.into());
+                    let (f, v) = if a_fixed { (i, j) } else { (j, i) };
+                    row[free_start + v] = -fixed[f].clone();
                     rows.push(row);
                 }
             }
+        };
+        if let Some(a0) = solution.proportional_to(start, alpha..alpha + na) {
+            push_rows(&a0, beta, true);
             anchors.push(describe("a", &a0));
         } else if let Some(b0) = solution.proportional_to(start, beta..beta + nb) {
-            for i in 0..na {
-                for j in 0..nb {
-                    let mut row = vec![Rational::from_integer(0.into()); n];
-                    row[w + i * nb + j] = one.clone();
-                    row[alpha + i] = -b0[j].clone();
-                    rows.push(row);
-                }
-            }
+            push_rows(&b0, alpha, false);
             anchors.push(describe("b", &b0));
         }
     }

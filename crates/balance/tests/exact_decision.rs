@@ -3,55 +3,20 @@
 //! exact decision must keep (monotone consistency, agreement with confident floating point,
 //! verdicts unmoved by a one-ulp change of an input).
 
+mod common;
+
 use std::collections::HashMap;
-use std::path::PathBuf;
+
+use common::{find, labels, model_of, palletizer_json, random_configuration, run};
 
 use counterpoise_balance::linear::{LiftedBasis, numeric_solve};
 use counterpoise_balance::{
-    Catalogue, Decision, SearchOptions, SearchReport, Status, VariantResult, Witness,
-    catalogue_options, mechanism_energy, realization_hints, search,
+    Catalogue, Decision, SearchReport, Status, VariantResult, Witness, catalogue_options,
+    mechanism_energy, realization_hints,
 };
+use counterpoise_model::Kinematics;
 use counterpoise_model::sampling::SplitMix64;
-use counterpoise_model::{Case, Kinematics, Model};
 use nalgebra::{DVector, Vector3};
-
-fn palletizer_json() -> serde_json::Value {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/palletizer.json");
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
-fn model_of(json: &serde_json::Value) -> Model {
-    Case::from_json_str(&json.to_string()).expect("valid case")
-}
-
-fn run(model: &Model, dmax: usize) -> SearchReport {
-    let energy = mechanism_energy(model);
-    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
-    search(
-        &energy,
-        catalogue,
-        SearchOptions {
-            dmax,
-            hints: realization_hints(model),
-        },
-    )
-}
-
-fn labels(v: &VariantResult) -> Vec<String> {
-    let mut l: Vec<String> = v.elements.iter().map(|e| e.label.clone()).collect();
-    l.sort();
-    l
-}
-
-fn find<'a>(report: &'a SearchReport, wanted: &[&str]) -> &'a VariantResult {
-    let mut wanted: Vec<String> = wanted.iter().map(|s| s.to_string()).collect();
-    wanted.sort();
-    report
-        .variants
-        .iter()
-        .find(|v| labels(v) == wanted)
-        .unwrap_or_else(|| panic!("{wanted:?} not enumerated"))
-}
 
 fn counts(report: &SearchReport) -> [usize; 5] {
     Status::ALL.map(|s| report.count(s))
@@ -366,14 +331,7 @@ fn a_counterweight_on_the_column_is_redundant() {
     let point = Vector3::new(0.37, -0.21, 0.0);
     let heights: Vec<f64> = (0..50)
         .map(|_| {
-            let q = DVector::from_iterator(
-                model.dof(),
-                model
-                    .coordinates
-                    .iter()
-                    .map(|c| rng.uniform(c.range[0], c.range[1])),
-            );
-            let pose = kinematics.body_pose(column, &q);
+            let pose = kinematics.body_pose(column, &random_configuration(&model, &mut rng));
             (pose.position + pose.rotation * point).y
         })
         .collect();

@@ -1,49 +1,17 @@
 //! The balance search on the reference palletizer (docs/palletizer.md, paper Sec. 3).
 
-use std::path::PathBuf;
+mod common;
 
+use common::{find, palletizer, run};
 use counterpoise_balance::verify::element_energy;
 use counterpoise_balance::{
-    Attachment, Catalogue, CounterweightParams, Decision, MechanismEnergy, SearchOptions,
-    SearchReport, SpringParams, Status, Witness, catalogue_options, mechanism_energy,
-    realization_hints, search,
+    Attachment, CounterweightParams, Decision, MechanismEnergy, SpringParams, Status, Witness,
+    mechanism_energy,
 };
+use counterpoise_model::Model;
 use counterpoise_model::sampling::SplitMix64;
-use counterpoise_model::{Case, Model};
 use counterpoise_symbolic::Point;
 use std::f64::consts::PI;
-
-fn palletizer() -> Model {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../cases/palletizer.json");
-    Case::from_path(&path).expect("the palletizer case is valid")
-}
-
-fn run(model: &Model, dmax: usize) -> SearchReport {
-    let energy = mechanism_energy(model);
-    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
-    search(
-        &energy,
-        catalogue,
-        SearchOptions {
-            dmax,
-            hints: realization_hints(model),
-        },
-    )
-}
-
-fn find<'a>(report: &'a SearchReport, labels: &[&str]) -> &'a counterpoise_balance::VariantResult {
-    let mut wanted: Vec<&str> = labels.to_vec();
-    wanted.sort_unstable();
-    report
-        .variants
-        .iter()
-        .find(|v| {
-            let mut have: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
-            have.sort_unstable();
-            have == wanted
-        })
-        .unwrap_or_else(|| panic!("variant {labels:?} not enumerated"))
-}
 
 /// Energy spread of the unbalanced robot plus `witness` over random configurations, relative to
 /// the unbalanced spread — computed here from the model's numeric poses, not by the crate.
