@@ -32,6 +32,7 @@ enum Command {
     },
     /// Find every set of at most Dmax balancing elements that balances the mechanism exactly.
     Variants {
+        /// Case file (JSON).
         case: PathBuf,
         /// Most elements per variant (default: the case's `balancing.dmax`).
         #[arg(long)]
@@ -43,6 +44,7 @@ enum Command {
     /// Phase 1: motor torques, joint reactions and the paper's indicators of the unbalanced
     /// mechanism over its task grid.
     Evaluate {
+        /// Case file (JSON).
         case: PathBuf,
         /// Print the report as JSON.
         #[arg(long)]
@@ -63,6 +65,7 @@ enum Command {
     /// The whole case study: unbalanced indicators, balance search, optimisation, ranking,
     /// reports (results.json, report.html, report.md, ranking.csv).
     Run {
+        /// Case file (JSON).
         case: PathBuf,
         /// Most elements per variant (default: the case's `balancing.dmax`).
         #[arg(long)]

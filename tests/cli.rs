@@ -288,3 +288,56 @@ fn usage_errors_exit_with_code_2() {
         assert!(stdout(&out).is_empty(), "{args:?}");
     }
 }
+
+#[test]
+fn a_zero_length_task_is_named_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let series = dir.path().join("series.json");
+    let series = series.to_str().unwrap();
+    let out = counterpoise(&[
+        "evaluate",
+        "cases/pendulum.json",
+        "--task",
+        "1,1",
+        "--series",
+        series,
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("task (1, 1) is a zero-length move"), "{err}");
+    // The pendulum's grid has 5 points: index 5 is out of range, and the message says so.
+    let out = counterpoise(&[
+        "evaluate",
+        "cases/pendulum.json",
+        "--task",
+        "0,5",
+        "--series",
+        series,
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(
+        err.contains("the grid has 5 points (indices 0 to 4)"),
+        "{err}"
+    );
+}
+
+#[test]
+fn check_names_the_path_of_the_balance_decision() {
+    let out = counterpoise(&["check", "cases/palletizer.json"]);
+    assert!(
+        stdout(&out).contains("balance decision: exact"),
+        "{}",
+        stdout(&out)
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = case_json("palletizer.json");
+    case["bodies"][0]["pose"][0]["rot_y"] = serde_json::json!("th1 + 0.3");
+    write_case(dir.path(), "turned.json", &case);
+    let path = dir.path().join("turned.json");
+    let out = counterpoise(&["check", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains("balance decision: numeric"), "{text}");
+    assert!(text.contains("bodies[0].pose[0].rot_y"), "{text}");
+}

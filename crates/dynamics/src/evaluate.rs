@@ -344,8 +344,11 @@ pub fn task_series_with(
     let spec = model.tasks.as_ref().ok_or(DynamicsError::NoTasks)?;
     let tasks = TaskSet::new(spec, samples)?;
     let points = tasks.points.len();
-    if i >= points || j >= points || i == j {
+    if i >= points || j >= points {
         return Err(DynamicsError::NoSuchTask { i, j, points });
+    }
+    if i == j {
+        return Err(DynamicsError::ZeroLengthTask { i });
     }
     let ev = Evaluator::new(model)?;
     let mut q = ev
