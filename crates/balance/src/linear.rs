@@ -155,16 +155,37 @@ pub fn solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
 }
 
 /// An exact consistent family rounded to doubles (the witness search and the optimiser work in
-/// floating point).
+/// floating point), in the numeric path's conventions: the free directions orthonormal in
+/// column-scaled units and the particular solution of least scaled norm. The exact family
+/// decides what the span is; this only picks the same basis of it that an SVD would.
 pub fn from_exact(basis: &LiftedBasis, solution: &ExactSolution) -> LinearSolution {
     use counterpoise_symbolic::rational_to_f64;
     let (matrix, offsets) = basis.system(&solution.elements);
     let cols = matrix.ncols();
     let column_scale = column_norms(&matrix);
-    let particular = DVector::from_iterator(cols, solution.particular.iter().map(rational_to_f64));
-    let nullspace = DMatrix::from_fn(cols, solution.nullspace.len(), |j, f| {
-        rational_to_f64(&solution.nullspace[f][j])
+    let scaled_particular = DVector::from_iterator(
+        cols,
+        solution
+            .particular
+            .iter()
+            .zip(column_scale.iter())
+            .map(|(x, s)| rational_to_f64(x) * s),
+    );
+    let scaled_null = DMatrix::from_fn(cols, solution.nullspace.len(), |j, f| {
+        rational_to_f64(&solution.nullspace[f][j]) * column_scale[j]
     });
+    let orthonormal = if scaled_null.ncols() == 0 {
+        scaled_null
+    } else {
+        scaled_null.qr().q()
+    };
+    let projected =
+        &scaled_particular - &orthonormal * (orthonormal.transpose() * &scaled_particular);
+    let particular = projected.component_div(&column_scale);
+    let mut nullspace = orthonormal;
+    for j in 0..cols {
+        nullspace.row_mut(j).scale_mut(1.0 / column_scale[j]);
+    }
     let b = &basis.unbalanced;
     let residual = (&matrix * &particular + b).norm() / b.norm().max(f64::MIN_POSITIVE);
     LinearSolution {
