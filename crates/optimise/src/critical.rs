@@ -116,6 +116,33 @@ pub fn optimise_all(
     variants: &[VariantResult],
     options: &OptimiseOptions,
 ) -> Vec<OptimisedVariant> {
+    optimise_all_timed(ctx, variants, options).0
+}
+
+/// Wall time of the stages of [`optimise_all`], seconds.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct StageTimings {
+    /// Relaxations, refinements and spring realizations of every pass.
+    pub solve: f64,
+    /// The all-task torque evaluations of the critical-task loop.
+    pub loop_grid: f64,
+    /// Spring choice by ΔR on the reaction tasks.
+    pub spring_choice: f64,
+    /// Final all-task evaluation (torques and joint reactions).
+    pub final_grid: f64,
+    /// Verification and records.
+    pub records: f64,
+    /// Passes of the critical-task loop.
+    pub passes: usize,
+}
+
+/// [`optimise_all`] with the wall time of each stage.
+pub fn optimise_all_timed(
+    ctx: &Context,
+    variants: &[VariantResult],
+    options: &OptimiseOptions,
+) -> (Vec<OptimisedVariant>, StageTimings) {
+    let mut timings = StageTimings::default();
     let mut runs: Vec<Run> = variants
         .iter()
         .filter(|v| v.status == Status::Balanced)
@@ -135,6 +162,8 @@ pub fn optimise_all(
             .collect::<BTreeSet<_>>()
             .into_iter()
             .collect();
+        timings.passes += 1;
+        let started = std::time::Instant::now();
         let (_, failures) = ctx.torques.get(&ctx.model, &ctx.tasks, &union);
         let failed: BTreeSet<usize> = failures.iter().map(|f| f.0).collect();
 
@@ -142,6 +171,8 @@ pub fn optimise_all(
             .par_iter()
             .map(|&k| (k, step(ctx, &runs[k], &failed, options)))
             .collect();
+        timings.solve += started.elapsed().as_secs_f64();
+        let started = std::time::Instant::now();
         let mut evaluated: Vec<usize> = Vec::new();
         for (k, outcome) in outcomes {
             match outcome {
@@ -156,7 +187,9 @@ pub fn optimise_all(
             continue;
         }
         let dyn_variants = candidate_variants(&runs, &evaluated);
-        let indicators = match grid_indicators(ctx, &dyn_variants, false) {
+        let indicators = grid_indicators(ctx, &dyn_variants, false);
+        timings.loop_grid += started.elapsed().as_secs_f64();
+        let indicators = match indicators {
             Ok(i) => i,
             Err(e) => {
                 for &k in &evaluated {
@@ -198,7 +231,8 @@ pub fn optimise_all(
             run.state = State::Stopped;
         }
     }
-    finish(ctx, runs, options)
+    let out = finish(ctx, runs, options, &mut timings);
+    (out, timings)
 }
 
 fn new_run(ctx: &Context, v: &VariantResult, options: &OptimiseOptions) -> Run {
@@ -535,25 +569,58 @@ fn reaction_peaks(ctx: &Context, variants: &[Variant], tasks: &[usize]) -> Optio
     Some(total)
 }
 
-/// ΔR (paper Eqs. 17–21): weighted positive percentage increases of the peak joint reactions.
+/// ΔR (paper Eqs. 17–21, percent) of a variant whose peak joint reactions are `force`, `moment`
+/// (one per joint, in the unbalanced indicators' joint order), against the unbalanced robot.
+///
+/// There is one definition of ΔR in the workspace: [`counterpoise_report::delta_r`], which the
+/// ranking uses. Calling it here means the springs are chosen by the very quantity they are
+/// ranked by. In particular a joint that carries no load in the unbalanced robot counts with
+/// its weighted term `γ·ΔF = (F − F_UB)/Σ F_UB · 100` (the continuous extension of Eq. 19 at
+/// `F_UB = 0`), so a spring that loads a previously idle joint is penalised.
+///
+/// `None` when the unbalanced robot has no joint reactions or a value is not finite.
 pub fn delta_r(unbalanced: &Indicators, force: &[f64], moment: &[f64]) -> Option<f64> {
-    if unbalanced.joints.is_empty() {
+    use counterpoise_report::JointReaction;
+    if unbalanced.joints.is_empty()
+        || force.len() != unbalanced.joints.len()
+        || moment.len() != unbalanced.joints.len()
+    {
         return None;
     }
-    let sf: f64 = unbalanced.joints.iter().map(|j| j.force).sum();
-    let sm: f64 = unbalanced.joints.iter().map(|j| j.moment).sum();
-    let mut total = 0.0;
-    for (k, j) in unbalanced.joints.iter().enumerate() {
-        if j.force > 0.0 && sf > 0.0 {
-            let d = ((force[k] - j.force) / j.force * 100.0).max(0.0);
-            total += j.force / sf * d;
-        }
-        if j.moment > 0.0 && sm > 0.0 {
-            let d = ((moment[k] - j.moment) / j.moment * 100.0).max(0.0);
-            total += j.moment / sm * d;
-        }
-    }
-    Some(total)
+    let reference: Vec<JointReaction> = unbalanced
+        .joints
+        .iter()
+        .map(|j| JointReaction {
+            name: j.name.clone(),
+            force: j.force,
+            moment: j.moment,
+        })
+        .collect();
+    let variant: Vec<JointReaction> = unbalanced
+        .joints
+        .iter()
+        .zip(force.iter().zip(moment))
+        .map(|(j, (&force, &moment))| JointReaction {
+            name: j.name.clone(),
+            force,
+            moment,
+        })
+        .collect();
+    counterpoise_report::delta_r(&reference, &variant)
+        .ok()
+        .map(|d| d.value)
+}
+
+/// The spring option to keep: the one with the lowest ΔR (paper Proc-9 ranks spring-only
+/// variants by ΔR, so the optimiser keeps the realization that ranks best); options without a
+/// score come last, ties go to the earliest option (the realization from the lifted optimum is
+/// first). `None` for no options.
+pub fn lowest_delta_r(scores: &[Option<f64>]) -> Option<usize> {
+    (0..scores.len()).min_by(|&a, &b| {
+        let sa = scores[a].unwrap_or(f64::INFINITY);
+        let sb = scores[b].unwrap_or(f64::INFINITY);
+        sa.total_cmp(&sb).then(a.cmp(&b))
+    })
 }
 
 /// Interval of coordinate `k` (others held) over which the convex lifted bounds hold.
@@ -641,7 +708,13 @@ fn free_parameters(
 type SpringChoice = (Vec<SpringValues>, DVector<f64>, Option<f64>);
 
 /// Spring choice by ΔR, final all-task evaluation, verification and the output records.
-fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<OptimisedVariant> {
+fn finish(
+    ctx: &Context,
+    mut runs: Vec<Run>,
+    options: &OptimiseOptions,
+    timings: &mut StageTimings,
+) -> Vec<OptimisedVariant> {
+    let started = std::time::Instant::now();
     // Reaction tasks: the critical tasks plus the unbalanced joints' critical tasks.
     let mut joint_tasks = BTreeSet::new();
     for j in &ctx.unbalanced.joints {
@@ -697,13 +770,7 @@ fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<O
                     .collect(),
                 None => vec![None; variants.len()],
             };
-            let best = (0..options_found.len())
-                .min_by(|&a, &b| {
-                    let sa = scores[a].unwrap_or(f64::INFINITY);
-                    let sb = scores[b].unwrap_or(f64::INFINITY);
-                    sa.total_cmp(&sb).then(a.cmp(&b))
-                })
-                .unwrap_or(0);
+            let best = lowest_delta_r(&scores).unwrap_or(0);
             let (s, x) = options_found.swap_remove(best);
             Some((s, x, scores[best]))
         })
@@ -714,6 +781,8 @@ fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<O
             c.x = x.clone();
         }
     }
+    timings.spring_choice = started.elapsed().as_secs_f64();
+    let started = std::time::Instant::now();
     // Final evaluation over all tasks, batched.
     let finals: Vec<usize> = (0..runs.len())
         .filter(|&k| {
@@ -735,11 +804,16 @@ fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<O
         });
     }
 
-    runs.into_iter()
+    timings.final_grid = started.elapsed().as_secs_f64();
+    let started = std::time::Instant::now();
+    let out = runs
+        .into_iter()
         .zip(choices)
         .zip(indicators_of)
         .map(|((run, choice), ind)| record(ctx, run, choice.and_then(|c| c.2), ind, options))
-        .collect()
+        .collect();
+    timings.records = started.elapsed().as_secs_f64();
+    out
 }
 
 fn record(
