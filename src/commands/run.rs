@@ -303,6 +303,8 @@ fn record(
         .collect();
     r.verification_residual = v.verification.map(|x| x.residual);
     let Some(opt) = opt else {
+        r.relations.clear();
+        r.free_directions.clear();
         return r;
     };
     r.optimiser = Some(OptimiserInfo {
@@ -365,6 +367,12 @@ fn record(
             r.status = VariantStatus::Discarded;
             r.reason = opt.reason.clone();
         }
+    }
+    if r.status != VariantStatus::Feasible {
+        // The reports show the balance relations of ranked variants only; the free directions
+        // of thousands of unranked variants at Dmax 3 were most of results.json.
+        r.relations.clear();
+        r.free_directions.clear();
     }
     r
 }

@@ -18,7 +18,7 @@ use counterpoise_balance::linear::solve;
 use counterpoise_balance::{Attachment, Status, VariantResult};
 use counterpoise_dynamics::params::{Counterweight, ParameterSet, Spring, Variant};
 use counterpoise_dynamics::runner::Workspace;
-use counterpoise_dynamics::{EvaluateOptions, Evaluator, Indicators, evaluate_grid};
+use counterpoise_dynamics::{EvaluateOptions, Evaluator, Indicators, evaluate_grid_indicators};
 use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -473,7 +473,10 @@ fn grid_indicators(
     let params = ParameterSet::from_variants(&ctx.model, variants).map_err(|e| e.to_string())?;
     let mut evaluate_options = EvaluateOptions::default();
     evaluate_options.reactions = reactions;
-    let grid = evaluate_grid(&ctx.model, &params, &evaluate_options).map_err(|e| e.to_string())?;
+    // Only the indicators are needed: the streaming evaluation keeps running maxima per
+    // variant instead of a table of every task and variant (tasks × variants × 33 values).
+    let grid = evaluate_grid_indicators(&ctx.model, &params, &evaluate_options)
+        .map_err(|e| e.to_string())?;
     Ok(grid.indicators)
 }
 
