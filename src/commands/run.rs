@@ -364,7 +364,11 @@ fn record(
             r.reason = Some("optimised, but not re-evaluated over all tasks".into());
         }
         (false, _) => {
-            r.status = VariantStatus::Discarded;
+            r.status = if opt.status == counterpoise_optimise::OptimisedStatus::Undecided {
+                VariantStatus::Undecided
+            } else {
+                VariantStatus::Discarded
+            };
             r.reason = opt.reason.clone();
         }
     }

@@ -83,7 +83,26 @@ enum State {
     Running,
     Converged,
     Stopped,
+    /// Proved impossible (the reason names the binding constraint).
     Discarded(String),
+    /// Not built, not proved impossible.
+    Undecided(String),
+}
+
+/// Why a pass produced no candidate.
+#[derive(Clone, Debug, PartialEq)]
+enum Failure {
+    Discard(String),
+    Undecided(String),
+}
+
+impl Failure {
+    fn into_state(self) -> State {
+        match self {
+            Failure::Discard(r) => State::Discarded(r),
+            Failure::Undecided(r) => State::Undecided(r),
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -91,7 +110,10 @@ struct Candidate {
     x: DVector<f64>,
     cws: Vec<CwPhysical>,
     springs: Vec<SpringValues>,
+    /// 0 (the trivial bound) when the relaxation was not solved.
     lower_bound: f64,
+    /// Whether `lower_bound` is the relaxation's certified bound.
+    bound_certified: bool,
     working_value: f64,
     relaxation_status: crate::clarabel_map::ConicStatus,
     relaxation_iterations: u32,
@@ -167,7 +189,7 @@ pub fn optimise_all_timed(
         let (_, failures) = ctx.torques.get(&ctx.model, &ctx.tasks, &union);
         let failed: BTreeSet<usize> = failures.iter().map(|f| f.0).collect();
 
-        let outcomes: Vec<(usize, Result<Candidate, String>)> = active
+        let outcomes: Vec<(usize, Result<Candidate, Failure>)> = active
             .par_iter()
             .map(|&k| (k, step(ctx, &runs[k], &failed, options)))
             .collect();
@@ -180,7 +202,7 @@ pub fn optimise_all_timed(
                     runs[k].candidate = Some(c);
                     evaluated.push(k);
                 }
-                Err(reason) => runs[k].state = State::Discarded(reason),
+                Err(failure) => runs[k].state = failure.into_state(),
             }
         }
         if evaluated.is_empty() {
@@ -193,7 +215,7 @@ pub fn optimise_all_timed(
             Ok(i) => i,
             Err(e) => {
                 for &k in &evaluated {
-                    runs[k].state = State::Discarded(format!("dynamics evaluation failed: {e}"));
+                    runs[k].state = State::Undecided(format!("dynamics evaluation failed: {e}"));
                 }
                 continue;
             }
@@ -291,21 +313,28 @@ fn new_run(ctx: &Context, v: &VariantResult, options: &OptimiseOptions) -> Run {
 }
 
 /// One pass for one variant: relaxation, recovery, refinement, springs.
+///
+/// A relaxation proved infeasible discards the variant (the certificate), with the binding
+/// constraint named. Any other status short of `Solved` is not a verdict: the local search
+/// starts from the relaxation's last iterate, the bounds-only relaxation's point and the
+/// particular solution in turn, and the pass continues without a certified lower bound (the
+/// trivial bound 0 is recorded). If no start leads to a point within every bound, the variant
+/// is undecided, with the smallest violation found.
 fn step(
     ctx: &Context,
     run: &Run,
     failed: &BTreeSet<usize>,
     options: &OptimiseOptions,
-) -> Result<Candidate, String> {
+) -> Result<Candidate, Failure> {
     let problem = run
         .problem
         .as_ref()
         .expect("running variants have a problem");
     if let Some(w) = run.working.iter().find(|w| failed.contains(w)) {
-        return Err(format!(
+        return Err(Failure::Undecided(format!(
             "the kinematics of critical task {:?} failed",
             ctx.pair(*w)
-        ));
+        )));
     }
     let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
     let relaxed = solve_relaxation(
@@ -315,51 +344,85 @@ fn step(
         options.solver_iterations,
     );
     let status = relaxed.solution.status;
-    if status.is_infeasible() {
-        return Err(format!(
-            "the bounds and peak limits cannot all be met: the convex relaxation is infeasible \
-             (clarabel: {})",
-            status.name()
-        ));
-    }
-    if status != crate::clarabel_map::ConicStatus::Solved {
-        // Often a nearly infeasible problem: the bounds alone may prove it.
-        let bounds_only = solve_bounds_only(problem, options.solver_iterations);
-        if bounds_only.is_infeasible() {
-            return Err(format!(
-                "the bounds cannot all be met: the convex relaxation of the bounds alone is infeasible (clarabel: {}; with the objective and peak limits: {})",
-                bounds_only.name(),
-                status.name()
-            ));
-        }
-        return Err(format!(
-            "the relaxation was not solved (clarabel: {})",
-            status.name()
-        ));
-    }
-    let lower = relaxed.bound;
-    let dirs = counterweight_directions(problem);
-    let z_fixed = project_fixed(problem, &relaxed.z);
-    let z_relaxed = project_radius(problem, &z_fixed, &dirs).unwrap_or(z_fixed);
-    let scale = lower.abs().max(1e-9);
-    let (_, v0, viol0) = merit(problem, &tasks, options.objective, &z_relaxed, scale);
-    let gap_before = if viol0 <= FEASIBILITY_TOL && v0.is_finite() {
-        ((v0 - lower) / v0.max(1e-300)).max(0.0)
-    } else {
-        f64::INFINITY
+    let discard = || {
+        Failure::Discard(crate::diagnose::infeasibility_reason(
+            problem,
+            &tasks,
+            options.objective,
+            options.solver_iterations,
+            &ctx.unbalanced
+                .actuators
+                .iter()
+                .map(|a| a.name.clone())
+                .collect::<Vec<_>>(),
+            |w| ctx.pair(w),
+        ))
     };
-    let z = if gap_before <= options.gap_tolerance {
-        z_relaxed
-    } else {
-        let refined = refine(problem, &tasks, options.objective, &z_relaxed, &dirs, scale);
-        if !refined.feasible {
-            return Err(format!(
-                "no parameters found that meet every bound and peak limit (smallest relative \
-                 violation {:.2e})",
-                refined.violation
-            ));
+    if status.is_infeasible() {
+        return Err(discard());
+    }
+    let solved = status == crate::clarabel_map::ConicStatus::Solved;
+    let mut starts = vec![relaxed.z.clone()];
+    if !solved {
+        let bounds_only = solve_bounds_only(problem, options.solver_iterations);
+        if bounds_only.solution.status.is_infeasible() {
+            return Err(discard());
         }
-        refined.z
+        starts.push(bounds_only.z);
+        starts.push(DVector::zeros(problem.dim()));
+        starts.retain(|z| z.iter().all(|v| v.is_finite()));
+    }
+    let lower = if solved { relaxed.bound } else { 0.0 };
+    let dirs = counterweight_directions(problem);
+    let scale = if solved {
+        lower.abs().max(1e-9)
+    } else {
+        tasks
+            .iter()
+            .flat_map(|t| t.base.iter())
+            .fold(0.0f64, |a, &b| a.max(b.abs()))
+            .max(1e-9)
+    };
+    let mut smallest_violation = f64::INFINITY;
+    let mut chosen: Option<(DVector<f64>, f64)> = None;
+    for z0 in &starts {
+        let z_fixed = project_fixed(problem, z0);
+        let z_start = project_radius(problem, &z_fixed, &dirs).unwrap_or(z_fixed);
+        let (_, v0, viol0) = merit(problem, &tasks, options.objective, &z_start, scale);
+        let gap_before = if solved && viol0 <= FEASIBILITY_TOL && v0.is_finite() {
+            ((v0 - lower) / v0.max(1e-300)).max(0.0)
+        } else {
+            f64::INFINITY
+        };
+        if gap_before <= options.gap_tolerance {
+            chosen = Some((z_start, gap_before));
+            break;
+        }
+        let refined = refine(problem, &tasks, options.objective, &z_start, &dirs, scale);
+        if refined.feasible {
+            chosen = Some((refined.z, gap_before));
+            break;
+        }
+        smallest_violation = smallest_violation.min(refined.violation);
+    }
+    let Some((z, gap_before)) = chosen else {
+        let limits = if problem.peak_limits.iter().any(Option::is_some) {
+            " and peak limit"
+        } else {
+            ""
+        };
+        let relaxation = if solved {
+            String::new()
+        } else {
+            format!(
+                "; the convex relaxation could not be solved either (clarabel: {})",
+                status.name()
+            )
+        };
+        return Err(Failure::Undecided(format!(
+            "no parameters meeting every bound{limits} were found from {} starting points              (smallest relative violation {smallest_violation:.2e}), but none are proved              impossible{relaxation}",
+            starts.len()
+        )));
     };
     let x = problem.lifted(&z);
     let (mut springs, mut note) = realize_springs(
@@ -401,9 +464,9 @@ fn step(
                 })
                 .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)))
                 .map(|(_, _, s, xj)| (s, xj))
-                .ok_or(note)?
+                .ok_or(Failure::Undecided(note))?
         }
-        None => return Err(note),
+        None => return Err(Failure::Undecided(note)),
     };
     let cws = problem.cw_physical(&x_full);
     let value = problem
@@ -414,6 +477,7 @@ fn step(
         cws,
         springs,
         lower_bound: lower,
+        bound_certified: solved,
         working_value: value,
         relaxation_status: status,
         relaxation_iterations: relaxed.solution.iterations,
@@ -846,11 +910,20 @@ fn record(
         verification: None,
         indicators: None,
     };
-    if let State::Discarded(reason) = &run.state {
-        out.reason = Some(reason.clone());
-        return out;
+    match &run.state {
+        State::Discarded(reason) => {
+            out.reason = Some(reason.clone());
+            return out;
+        }
+        State::Undecided(reason) => {
+            out.status = OptimisedStatus::Undecided;
+            out.reason = Some(reason.clone());
+            return out;
+        }
+        _ => {}
     }
     let (Some(problem), Some(cand)) = (run.problem.as_ref(), run.candidate.as_ref()) else {
+        out.status = OptimisedStatus::Undecided;
         out.reason = Some("no candidate parameters were produced".into());
         return out;
     };
@@ -884,51 +957,64 @@ fn record(
         })
         .collect();
     out.free_parameters = free_parameters(problem, &run.free_components, &cand.x);
-    out.lower_bound = Some(cand.lower_bound);
+    out.lower_bound = cand.bound_certified.then_some(cand.lower_bound);
     let ind = match indicators {
         Some(Ok(i)) => i,
         Some(Err(e)) => {
+            out.status = OptimisedStatus::Undecided;
             out.reason = Some(format!("final dynamics evaluation failed: {e}"));
             return out;
         }
         None => {
+            out.status = OptimisedStatus::Undecided;
             out.reason = Some("no final evaluation".into());
             return out;
         }
     };
     let objective = objective_of(&ind, options.objective);
     out.objective = Some(objective);
-    out.gap = Some(((objective - cand.lower_bound) / objective.abs().max(1e-300)).max(0.0));
+    out.gap = out
+        .lower_bound
+        .map(|lb| ((objective - lb) / objective.abs().max(1e-300)).max(0.0));
     let report = verify(problem, &ctx.checks, &cand.cws, &cand.springs, &ind);
     out.residual = Some(report.balance_residual);
     let passed = report.passed;
     if !passed {
+        // A peak over a limit at the optimised point is a verified violation (discarded);
+        // a balance or bound check that fails is a numerical shortfall (undecided).
         let mut why = Vec::new();
-        if !report.balance_passed {
-            why.push(format!(
-                "balance residual {:.2e} exceeds 1e-9",
-                report.balance_residual
-            ));
-        }
-        if !report.bounds_passed {
-            why.push(format!(
-                "a bound is exceeded (relative {:.2e})",
-                report.bound_excess
-            ));
-        }
         if !report.peaks_passed {
-            for p in &report.peaks {
+            for (n, p) in report.peaks.iter().enumerate() {
                 if let Some(l) = p.limit
                     && p.peak > l
                 {
+                    let task = ind.actuators.get(n).map_or(String::new(), |a| {
+                        format!(" on task {}→{}", a.cpt[0], a.cpt[1])
+                    });
                     why.push(format!(
-                        "{} peaks at {:.3} N·m over all tasks (limit {l})",
+                        "{} peaks at {:.2} N·m{task} (limit {l} N·m)",
                         p.actuator, p.peak
                     ));
                 }
             }
         }
-        out.reason = Some(format!("verification failed: {}", why.join("; ")));
+        if !report.balance_passed || !report.bounds_passed {
+            out.status = OptimisedStatus::Undecided;
+            if !report.balance_passed {
+                why.push(format!(
+                    "the optimised parameters balance only to a relative residual of {:.2e} \
+                     (1e-9 required)",
+                    report.balance_residual
+                ));
+            }
+            if !report.bounds_passed {
+                why.push(format!(
+                    "the optimised parameters exceed a bound by {:.2e} (relative)",
+                    report.bound_excess
+                ));
+            }
+        }
+        out.reason = Some(why.join("; "));
     } else {
         out.status = OptimisedStatus::Feasible;
         if run.state == State::Stopped {

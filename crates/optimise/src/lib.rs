@@ -24,6 +24,7 @@
 pub mod clarabel_map;
 pub mod context;
 pub mod critical;
+pub mod diagnose;
 pub mod error;
 pub mod overrides;
 pub mod problem;

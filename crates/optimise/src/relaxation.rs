@@ -385,11 +385,6 @@ pub fn solve_relaxation(
 
 /// The relaxation of the bounds alone (no tasks, no objective): its infeasibility proves that no
 /// parameters within the bounds balance the variant.
-pub fn solve_bounds_only(
-    problem: &VariantProblem,
-    max_iter: u32,
-) -> crate::clarabel_map::ConicStatus {
+pub fn solve_bounds_only(problem: &VariantProblem, max_iter: u32) -> Relaxed {
     solve_relaxation(problem, &[], Objective::Minimax, max_iter)
-        .solution
-        .status
 }
