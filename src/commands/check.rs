@@ -12,8 +12,35 @@ pub fn run(path: &Path) -> Result<ExitCode> {
     let Some(model) = super::load(path)? else {
         return Ok(ExitCode::FAILURE);
     };
+    let errors = override_errors(&model);
+    if !errors.is_empty() {
+        eprintln!("{}: {} error(s)", path.display(), errors.len());
+        for e in &errors {
+            eprintln!("  {e}");
+        }
+        return Ok(ExitCode::FAILURE);
+    }
     print!("{}", summary(&model));
     Ok(ExitCode::SUCCESS)
+}
+
+/// The errors of `balancing.overrides` (unknown element, a field the element does not have,
+/// lo > hi, contradictory anchor constraints), each naming its field path; they need the
+/// catalogue of candidate elements, so the model's own validation cannot see them.
+pub fn override_errors(model: &Model) -> Vec<String> {
+    if model.balancing.is_none() {
+        return Vec::new();
+    }
+    let energy = counterpoise_balance::mechanism_energy(model);
+    let catalogue = counterpoise_balance::Catalogue::build(
+        &energy,
+        &counterpoise_balance::catalogue_options(model),
+    );
+    match counterpoise_optimise::BoundsTable::new(model, &catalogue) {
+        Ok(_) => Vec::new(),
+        Err(counterpoise_optimise::OptimiseError::Overrides(errors)) => errors,
+        Err(e) => vec![e.to_string()],
+    }
 }
 
 fn coordinate_names(model: &Model) -> (Vec<&str>, Vec<bool>) {

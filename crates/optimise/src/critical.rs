@@ -420,7 +420,9 @@ fn step(
             )
         };
         return Err(Failure::Undecided(format!(
-            "no parameters meeting every bound{limits} were found from {} starting points              (smallest relative violation {smallest_violation:.2e}), but none are proved              impossible{relaxation}",
+            "no parameters meeting every bound{limits} were found from {} starting points \
+             (smallest relative violation {smallest_violation:.2e}), but none are proved \
+             impossible{relaxation}",
             starts.len()
         )));
     };
