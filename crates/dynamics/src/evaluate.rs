@@ -263,9 +263,7 @@ pub fn evaluate_grid_indicators(
         options.reactions,
         crate::fast::GridSink::Maxima(&mut maxima),
     );
-    let indicators = maxima.finish(&ev.actuator_names(), &ev.joint_names(), |w| {
-        tasks.pair(w)
-    });
+    let indicators = maxima.finish(&ev.actuator_names(), &ev.joint_names(), |w| tasks.pair(w));
     Ok(GridIndicators {
         indicators,
         excluded: excluded_from(&failures),

@@ -74,7 +74,10 @@ fn streaming_indicators_equal_the_table_reduction() {
             let streamed = pool
                 .install(|| evaluate_grid_indicators(&model, &params, &options))
                 .unwrap();
-            assert_eq!(streamed.indicators, table.indicators, "reactions {reactions}");
+            assert_eq!(
+                streamed.indicators, table.indicators,
+                "reactions {reactions}"
+            );
             assert_eq!(streamed.excluded, table.excluded);
             assert_eq!(streamed.distinct_moves, table.distinct_moves);
             assert_eq!(

@@ -584,8 +584,8 @@ fn motor_indicators(ctx: &Context, variants: &[Variant]) -> Result<Vec<Indicator
         reactions: false,
         ..EvaluateOptions::default()
     };
-    let grid = evaluate_grid_indicators(gravity_free, &params, &options)
-        .map_err(|e| e.to_string())?;
+    let grid =
+        evaluate_grid_indicators(gravity_free, &params, &options).map_err(|e| e.to_string())?;
     Ok(column.iter().map(|&c| grid.indicators[c].clone()).collect())
 }
 

@@ -239,8 +239,10 @@ fn apply(
         if key == "element" {
             continue;
         }
-        if let (ElementBounds::Spring(b), "anchor_a_box" | "anchor_b_box" | "anchor_a_fixed" | "anchor_b_fixed") =
-            (&mut entries[entry], key.as_str())
+        if let (
+            ElementBounds::Spring(b),
+            "anchor_a_box" | "anchor_b_box" | "anchor_a_fixed" | "anchor_b_fixed",
+        ) = (&mut entries[entry], key.as_str())
         {
             let parsed = if key.ends_with("_box") {
                 anchor_box(v)
@@ -256,7 +258,9 @@ fn apply(
         }
         let known = match &entries[entry] {
             ElementBounds::Counterweight(_) => ["mass", "radius"].contains(&key.as_str()),
-            ElementBounds::Spring(_) => ["stiffness", "anchor_a", "anchor_b"].contains(&key.as_str()),
+            ElementBounds::Spring(_) => {
+                ["stiffness", "anchor_a", "anchor_b"].contains(&key.as_str())
+            }
         };
         if !known {
             errors.push(match &entries[entry] {

@@ -440,7 +440,10 @@ pub fn realize_springs(
                 }
             }
             // Start inside the anchor boxes.
-            for (bx, axes, offset) in [(&s.bounds.box_a, &s.axes_a, 1), (&s.bounds.box_b, &s.axes_b, 1 + na)] {
+            for (bx, axes, offset) in [
+                (&s.bounds.box_a, &s.axes_a, 1),
+                (&s.bounds.box_b, &s.axes_b, 1 + na),
+            ] {
                 for (i, &axis) in axes.iter().enumerate() {
                     let [lo, hi] = bx[axis];
                     y0[u + offset + i] = y0[u + offset + i].clamp(lo, hi);

@@ -34,7 +34,11 @@ fn a_fixed_anchor_and_a_box_are_met_and_the_spring_balances() {
         assert!((s.anchor_a[k] - want).abs() <= 1e-9, "a = {:?}", s.anchor_a);
     }
     let by = s.anchor_b[1];
-    assert!((0.3 - 1e-9..=0.5 + 1e-9).contains(&by), "b = {:?}", s.anchor_b);
+    assert!(
+        (0.3 - 1e-9..=0.5 + 1e-9).contains(&by),
+        "b = {:?}",
+        s.anchor_b
+    );
     assert!(s.anchor_b[0].abs() <= 1e-9, "b = {:?}", s.anchor_b);
     let moment = s.stiffness * s.anchor_a[0] * by;
     assert!((moment - 9.81).abs() <= 1e-8 * 9.81, "K·a·b = {moment}");

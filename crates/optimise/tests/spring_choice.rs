@@ -69,9 +69,18 @@ fn a_joint_idle_in_the_unbalanced_robot_counts_when_it_gets_loaded() {
 fn the_spring_option_with_the_lowest_delta_r_is_kept() {
     // Three realizations with ΔR 12, 3 and 40 %: the second is the one to keep, whichever
     // position the best one holds.
-    assert_eq!(lowest_delta_r(&[Some(12.0), Some(3.0), Some(40.0)]), Some(1));
-    assert_eq!(lowest_delta_r(&[Some(3.0), Some(12.0), Some(40.0)]), Some(0));
-    assert_eq!(lowest_delta_r(&[Some(40.0), Some(12.0), Some(3.0)]), Some(2));
+    assert_eq!(
+        lowest_delta_r(&[Some(12.0), Some(3.0), Some(40.0)]),
+        Some(1)
+    );
+    assert_eq!(
+        lowest_delta_r(&[Some(3.0), Some(12.0), Some(40.0)]),
+        Some(0)
+    );
+    assert_eq!(
+        lowest_delta_r(&[Some(40.0), Some(12.0), Some(3.0)]),
+        Some(2)
+    );
     // An option without a score (its reactions could not be evaluated) is never preferred.
     assert_eq!(lowest_delta_r(&[None, Some(7.0)]), Some(1));
     // Ties go to the earliest option (the realization from the lifted optimum).
