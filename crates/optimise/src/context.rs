@@ -26,10 +26,6 @@ pub struct Context {
     /// Indicators of the unbalanced mechanism over all tasks (with joint reactions, for ΔR).
     pub unbalanced: Indicators,
     pub torques: TorqueCache,
-    /// The model without gravity, when every payload is in the balance: a balanced variant's
-    /// motor torque is then that of this model with its counterweights alone (gravity and
-    /// springs cancel exactly). `None` otherwise.
-    pub gravity_free: Option<Model>,
 }
 
 impl Context {
@@ -71,13 +67,7 @@ impl Context {
                 Element::Spring { .. } => None,
             })
             .collect();
-        let gravity_free = model.payloads.iter().all(|p| p.in_balance).then(|| {
-            let mut m = model.clone();
-            m.gravity = nalgebra::Vector3::zeros();
-            m
-        });
         Ok(Context {
-            gravity_free,
             torques: TorqueCache::new(model, cw_bodies),
             model: model.clone(),
             energy,

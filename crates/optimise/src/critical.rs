@@ -209,7 +209,7 @@ pub fn optimise_all_timed(
             continue;
         }
         let dyn_variants = candidate_variants(&runs, &evaluated);
-        let indicators = motor_indicators(ctx, &dyn_variants);
+        let indicators = grid_indicators(ctx, &dyn_variants, false);
         timings.loop_grid += started.elapsed().as_secs_f64();
         let indicators = match indicators {
             Ok(i) => i,
@@ -544,49 +544,6 @@ fn grid_indicators(
     let grid = evaluate_grid_indicators(&ctx.model, &params, &evaluate_options)
         .map_err(|e| e.to_string())?;
     Ok(grid.indicators)
-}
-
-/// The all-task motor-torque indicators of balanced candidates (no reactions), for the
-/// critical-task loop. Gravity and springs cancel exactly in a balanced variant, so its motor
-/// torque is that of the gravity-free mechanism with its counterweights alone: candidates with
-/// the same counterweights (every spring-only variant, for one) share one evaluated column.
-/// With payloads outside the balance the full model is evaluated, one column per candidate.
-fn motor_indicators(ctx: &Context, variants: &[Variant]) -> Result<Vec<Indicators>, String> {
-    let Some(gravity_free) = &ctx.gravity_free else {
-        return grid_indicators(ctx, variants, false);
-    };
-    let key = |v: &Variant| -> Vec<(usize, [u64; 4])> {
-        v.counterweights
-            .iter()
-            .map(|c| {
-                let [x, y, z] = c.position.map(f64::to_bits);
-                (c.body, [c.mass.to_bits(), x, y, z])
-            })
-            .collect()
-    };
-    let mut index: std::collections::HashMap<Vec<(usize, [u64; 4])>, usize> =
-        std::collections::HashMap::new();
-    let mut distinct: Vec<Variant> = Vec::new();
-    let column: Vec<usize> = variants
-        .iter()
-        .map(|v| {
-            *index.entry(key(v)).or_insert_with(|| {
-                distinct.push(Variant {
-                    counterweights: v.counterweights.clone(),
-                    springs: Vec::new(),
-                });
-                distinct.len() - 1
-            })
-        })
-        .collect();
-    let params = ParameterSet::from_variants(gravity_free, &distinct).map_err(|e| e.to_string())?;
-    let options = EvaluateOptions {
-        reactions: false,
-        ..EvaluateOptions::default()
-    };
-    let grid =
-        evaluate_grid_indicators(gravity_free, &params, &options).map_err(|e| e.to_string())?;
-    Ok(column.iter().map(|&c| grid.indicators[c].clone()).collect())
 }
 
 /// The objective over all tasks from a variant's indicators.
