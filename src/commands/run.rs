@@ -297,7 +297,13 @@ fn record(
         .free_directions
         .iter()
         .map(|f| FreeDirection {
-            components: f.components.clone(),
+            // Nine significant digits: the reports show four, and at Dmax 3 the directions
+            // of the ranked variants are half of results.json.
+            components: f
+                .components
+                .iter()
+                .map(|(name, c)| (name.clone(), significant(*c, 9)))
+                .collect(),
             positive_interval: f.positive_interval,
         })
         .collect();
@@ -379,6 +385,17 @@ fn record(
         r.free_directions.clear();
     }
     r
+}
+
+/// `x` rounded to `digits` significant digits (through the decimal representation, so the JSON
+/// holds the short form).
+fn significant(x: f64, digits: usize) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    format!("{x:.*e}", digits.saturating_sub(1))
+        .parse()
+        .unwrap_or(x)
 }
 
 /// The dynamics crate's description of a variant's elements.
