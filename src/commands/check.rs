@@ -15,8 +15,17 @@ pub fn run(path: &Path) -> Result<ExitCode> {
     };
     // What `variants`, `evaluate` and `run` would otherwise find only later.
     let (problems, reach) = counterpoise::preflight::problems(&model);
-    if !problems.is_empty() {
-        super::print_errors(path, &super::located(path, problems));
+    let overrides = override_errors(&model);
+    if !problems.is_empty() || !overrides.is_empty() {
+        if !problems.is_empty() {
+            super::print_errors(path, &super::located(path, problems));
+        }
+        if !overrides.is_empty() {
+            eprintln!("{}: {} error(s)", path.display(), overrides.len());
+            for e in &overrides {
+                eprintln!("  {e}");
+            }
+        }
         return Ok(ExitCode::FAILURE);
     }
     print!("{}", summary(&model));
@@ -53,6 +62,25 @@ fn clipped(description: &str) -> String {
             &description[..cut],
             description[cut..].chars().count()
         ),
+    }
+}
+
+/// The errors of `balancing.overrides` (unknown element, a field the element does not have,
+/// lo > hi, contradictory anchor constraints), each naming its field path; they need the
+/// catalogue of candidate elements, so the model's own validation cannot see them.
+pub fn override_errors(model: &Model) -> Vec<String> {
+    if model.balancing.is_none() {
+        return Vec::new();
+    }
+    let energy = counterpoise_balance::mechanism_energy(model);
+    let catalogue = counterpoise_balance::Catalogue::build(
+        &energy,
+        &counterpoise_balance::catalogue_options(model),
+    );
+    match counterpoise_optimise::BoundsTable::new(model, &catalogue) {
+        Ok(_) => Vec::new(),
+        Err(counterpoise_optimise::OptimiseError::Overrides(errors)) => errors,
+        Err(e) => vec![e.to_string()],
     }
 }
 

@@ -300,12 +300,20 @@ fn record(
         .free_directions
         .iter()
         .map(|f| FreeDirection {
-            components: f.components.clone(),
+            // Nine significant digits: the reports show four, and at Dmax 3 the directions
+            // of the ranked variants are half of results.json.
+            components: f
+                .components
+                .iter()
+                .map(|(name, c)| (name.clone(), significant(*c, 9)))
+                .collect(),
             positive_interval: f.positive_interval,
         })
         .collect();
     r.verification_residual = v.verification.map(|x| x.residual);
     let Some(opt) = opt else {
+        r.relations.clear();
+        r.free_directions.clear();
         return r;
     };
     r.optimiser = Some(OptimiserInfo {
@@ -365,11 +373,32 @@ fn record(
             r.reason = Some("optimised, but not re-evaluated over all tasks".into());
         }
         (false, _) => {
-            r.status = VariantStatus::Discarded;
+            r.status = if opt.status == counterpoise_optimise::OptimisedStatus::Undecided {
+                VariantStatus::Undecided
+            } else {
+                VariantStatus::Discarded
+            };
             r.reason = opt.reason.clone();
         }
     }
+    if r.status != VariantStatus::Feasible {
+        // The reports show the balance relations of ranked variants only; the free directions
+        // of thousands of unranked variants at Dmax 3 were most of results.json.
+        r.relations.clear();
+        r.free_directions.clear();
+    }
     r
+}
+
+/// `x` rounded to `digits` significant digits (through the decimal representation, so the JSON
+/// holds the short form).
+fn significant(x: f64, digits: usize) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    format!("{x:.*e}", digits.saturating_sub(1))
+        .parse()
+        .unwrap_or(x)
 }
 
 /// The dynamics crate's description of a variant's elements.

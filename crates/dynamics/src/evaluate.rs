@@ -48,7 +48,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{DynamicsError, TaskFailure};
-use crate::indicators::{Indicators, StatsTable, TaskStats, reduce};
+use crate::indicators::{IndicatorAccumulator, Indicators, StatsTable, TaskStats, reduce};
 use crate::params::ParameterSet;
 use crate::reactions::JointReactions;
 use crate::runner::{Evaluator, Workspace};
@@ -170,9 +170,14 @@ pub fn evaluate_grid(
     };
     let mut table = StatsTable::new(tasks.len(), params.len(), ev.mech.n, joints);
     let (failures, distinct) = match cyclic {
-        Some(cyc) => {
-            crate::fast::evaluate_cyclic(&ev, cyc, &tasks, params, options.reactions, &mut table)
-        }
+        Some(cyc) => crate::fast::evaluate_cyclic(
+            &ev,
+            cyc,
+            &tasks,
+            params,
+            options.reactions,
+            crate::fast::GridSink::Table(&mut table),
+        ),
         None => {
             let mut failures = Vec::new();
             for (w, r) in direct_tasks(&ev, &tasks, params, options.reactions)
@@ -203,6 +208,67 @@ pub fn evaluate_grid(
         cyclic_coordinate: cyclic.map(|c| model.coordinates[c.coordinate].name.clone()),
         distinct_moves: distinct,
         tasks,
+    })
+}
+
+/// The indicators of many columns over the grid, without the per-task table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridIndicators {
+    /// One per column.
+    pub indicators: Vec<Indicators>,
+    pub excluded: Excluded,
+    pub reactions_minimum_norm: bool,
+    pub distinct_moves: usize,
+}
+
+/// [`evaluate_grid`]'s indicators, computed without keeping the statistics of every task and
+/// column: with a cyclic coordinate each worker keeps running maxima per column (ties to the
+/// lowest task, as [`reduce`]), so memory does not grow with tasks × columns. The indicators
+/// are identical to [`evaluate_grid`]'s for any thread count.
+pub fn evaluate_grid_indicators(
+    model: &Model,
+    params: &ParameterSet,
+    options: &EvaluateOptions,
+) -> Result<GridIndicators, DynamicsError> {
+    let tasks = TaskSet::new(
+        model.tasks.as_ref().ok_or(DynamicsError::NoTasks)?,
+        options.samples,
+    )?;
+    let ev = Evaluator::new(model)?;
+    let cyclic = if options.shortcut && params.springs.iter().all(|s| s.other.is_some()) {
+        crate::symmetry::detect_cyclic(model, &ev.mech)
+    } else {
+        None
+    };
+    let Some(cyc) = cyclic else {
+        let grid = evaluate_grid(model, params, options)?;
+        return Ok(GridIndicators {
+            indicators: grid.indicators,
+            excluded: grid.excluded,
+            reactions_minimum_norm: grid.reactions_minimum_norm,
+            distinct_moves: grid.distinct_moves,
+        });
+    };
+    let joints = if options.reactions {
+        ev.reactions.joint_count()
+    } else {
+        0
+    };
+    let mut maxima = IndicatorAccumulator::new(params.len(), ev.mech.n, joints);
+    let (failures, distinct) = crate::fast::evaluate_cyclic(
+        &ev,
+        cyc,
+        &tasks,
+        params,
+        options.reactions,
+        crate::fast::GridSink::Maxima(&mut maxima),
+    );
+    let indicators = maxima.finish(&ev.actuator_names(), &ev.joint_names(), |w| tasks.pair(w));
+    Ok(GridIndicators {
+        indicators,
+        excluded: excluded_from(&failures),
+        reactions_minimum_norm: options.reactions && ev.reactions.minimum_norm,
+        distinct_moves: distinct,
     })
 }
 

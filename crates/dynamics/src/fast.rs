@@ -30,7 +30,7 @@ use counterpoise_symbolic::MAX_VARS;
 use rayon::prelude::*;
 
 use crate::error::{FailureReason, TaskFailure};
-use crate::indicators::StatsTable;
+use crate::indicators::{IndicatorAccumulator, StatsTable};
 use crate::kernel::{
     ColumnBatch, actuator_forces, actuator_forces_batch, required_wrenches, required_wrenches_batch,
 };
@@ -153,7 +153,14 @@ impl TaskRows {
     }
 }
 
-/// Runs the grid through the cyclic decomposition into `table`; returns the failures in task
+/// Where the statistics of the grid go: a table of every task and column, or running maxima
+/// (the indicators only, a few values per column).
+pub(crate) enum GridSink<'a> {
+    Table(&'a mut StatsTable),
+    Maxima(&'a mut IndicatorAccumulator),
+}
+
+/// Runs the grid through the cyclic decomposition into `sink`; returns the failures in task
 /// order and the number of distinct moves evaluated.
 pub(crate) fn evaluate_cyclic(
     ev: &Evaluator,
@@ -161,7 +168,7 @@ pub(crate) fn evaluate_cyclic(
     tasks: &TaskSet,
     params: &ParameterSet,
     with_reactions: bool,
-    table: &mut StatsTable,
+    sink: GridSink,
 ) -> (Vec<TaskFailure>, usize) {
     let mech = &ev.mech;
     let n = mech.n;
@@ -254,81 +261,119 @@ pub(crate) fn evaluate_cyclic(
     };
     let per_sample_stride = params.len() * (3 * na + 10 * nj);
     let groups = InertiaGroups::new(params);
-    let computed: Vec<SubTaskOutcome> = (0..st_pairs.len())
-        .into_par_iter()
-        .map_init(Work::default, |work, st| {
-            let (s1, s2) = st_pairs[st];
-            let data = match &sub_q[s1] {
-                Err(reason) => Err((0, reason.clone())),
-                Ok(q0) => sub_task(
-                    ev,
-                    cyc,
-                    &sub_u[s1],
-                    &sub_u[s2],
-                    q0,
-                    tasks.duration,
-                    ns,
-                    params,
-                    &groups,
-                    with_reactions,
-                    per_sample_stride,
-                    work,
-                ),
-            };
-            match data {
-                Ok(()) => {}
-                Err((k, reason)) => {
-                    return Err(users[st]
-                        .iter()
-                        .map(|&(w, rev, _)| {
-                            let sample = if rev { ns - 1 - k } else { k };
-                            let reason = reason.clone();
-                            TaskFailure {
-                                task: w,
-                                sample,
-                                reason,
-                            }
-                        })
-                        .collect());
-                }
-            }
-            // Tasks whose Δ agree to 1e-12 of the cyclic span share one evaluation (grid
-            // differences such as θ(3) − θ(1) and θ(4) − θ(2) differ in the last bits); the
-            // first task of a group (lowest index) provides its Δ.
-            let mut index: HashMap<(bool, i64), usize> = HashMap::new();
-            let mut unique: Vec<(bool, f64)> = Vec::new();
-            let slot: Vec<usize> = users[st]
-                .iter()
-                .map(|&(_, rev, delta)| {
-                    let key = (rev, (delta / delta_quantum).round() as i64);
-                    *index.entry(key).or_insert_with(|| {
-                        unique.push((rev, delta));
-                        unique.len() - 1
-                    })
-                })
-                .collect();
-            let rows = task_stats(
-                &work.coefficients,
-                per_sample_stride,
-                &unique,
+    let one_sub_task = |work: &mut Work, st: usize| -> SubTaskOutcome {
+        let (s1, s2) = st_pairs[st];
+        let data = match &sub_q[s1] {
+            Err(reason) => Err((0, reason.clone())),
+            Ok(q0) => sub_task(
+                ev,
+                cyc,
+                &sub_u[s1],
+                &sub_u[s2],
+                q0,
+                tasks.duration,
                 ns,
-                params.len(),
-                na,
-                nj,
-            );
-            Ok((rows, users[st].iter().map(|u| u.0).zip(slot).collect()))
-        })
-        .collect();
+                params,
+                &groups,
+                with_reactions,
+                per_sample_stride,
+                work,
+            ),
+        };
+        match data {
+            Ok(()) => {}
+            Err((k, reason)) => {
+                return Err(users[st]
+                    .iter()
+                    .map(|&(w, rev, _)| {
+                        let sample = if rev { ns - 1 - k } else { k };
+                        let reason = reason.clone();
+                        TaskFailure {
+                            task: w,
+                            sample,
+                            reason,
+                        }
+                    })
+                    .collect());
+            }
+        }
+        // Tasks whose Δ agree to 1e-12 of the cyclic span share one evaluation (grid
+        // differences such as θ(3) − θ(1) and θ(4) − θ(2) differ in the last bits); the
+        // first task of a group (lowest index) provides its Δ.
+        let mut index: HashMap<(bool, i64), usize> = HashMap::new();
+        let mut unique: Vec<(bool, f64)> = Vec::new();
+        let slot: Vec<usize> = users[st]
+            .iter()
+            .map(|&(_, rev, delta)| {
+                let key = (rev, (delta / delta_quantum).round() as i64);
+                *index.entry(key).or_insert_with(|| {
+                    unique.push((rev, delta));
+                    unique.len() - 1
+                })
+            })
+            .collect();
+        let rows = task_stats(
+            &work.coefficients,
+            per_sample_stride,
+            &unique,
+            ns,
+            params.len(),
+            na,
+            nj,
+        );
+        Ok((rows, users[st].iter().map(|u| u.0).zip(slot).collect()))
+    };
     let mut distinct = 0;
-    for outcome in computed {
-        match outcome {
-            Ok((rows, assignment)) => {
-                distinct += rows.len();
-                for (w, u) in assignment {
-                    table.set_rows(w, rows.task(u));
+    match sink {
+        GridSink::Table(table) => {
+            let computed: Vec<SubTaskOutcome> = (0..st_pairs.len())
+                .into_par_iter()
+                .map_init(Work::default, |work, st| one_sub_task(work, st))
+                .collect();
+            for outcome in computed {
+                match outcome {
+                    Ok((rows, assignment)) => {
+                        distinct += rows.len();
+                        for (w, u) in assignment {
+                            table.set_rows(w, rows.task(u));
+                        }
+                    }
+                    Err(f) => failures.extend(f),
                 }
             }
-            Err(f) => failures.extend(f),
+        }
+        GridSink::Maxima(acc) => {
+            // Each worker folds its sub-tasks into its own maxima; the merge is order-free
+            // (ties to the lowest task), so the result does not depend on the split.
+            let empty = IndicatorAccumulator::new(acc.columns, acc.actuators, acc.joints);
+            let (maxima, failed, count) = (0..st_pairs.len())
+                .into_par_iter()
+                .map_init(Work::default, |work, st| one_sub_task(work, st))
+                .fold(
+                    || (empty.clone(), Vec::new(), 0usize),
+                    |(mut m, mut failed, mut count), outcome| {
+                        match outcome {
+                            Ok((rows, assignment)) => {
+                                count += rows.len();
+                                for (w, u) in assignment {
+                                    m.add_rows(w, rows.task(u));
+                                }
+                            }
+                            Err(f) => failed.extend(f),
+                        }
+                        (m, failed, count)
+                    },
+                )
+                .reduce(
+                    || (empty.clone(), Vec::new(), 0usize),
+                    |(m, mut f1, c1), (other, f2, c2)| {
+                        f1.extend(f2);
+                        (m.merge(&other), f1, c1 + c2)
+                    },
+                );
+            *acc = acc.clone().merge(&maxima);
+            failures.extend(failed);
+            distinct = count;
         }
     }
     failures.sort_by_key(|f| f.task);

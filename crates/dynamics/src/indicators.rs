@@ -294,3 +294,130 @@ pub fn reduce(
             .collect(),
     }
 }
+
+/// The running maxima of [`reduce`] for many columns at once, fed task by task in *any* order:
+/// a value replaces the current one when it is larger, or equal and from a lower task index,
+/// so the result is the one [`reduce`] gives on the full table (ties to the lowest task)
+/// whatever order or split the tasks arrive in. It lets a grid evaluation keep a few values per
+/// column instead of a table of every task and column.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IndicatorAccumulator {
+    pub columns: usize,
+    pub actuators: usize,
+    pub joints: usize,
+    /// Per column: QTR, QIT, CRT (na), CPT (na), F_j (nj), M_j (nj) as `(value, task)`.
+    best: Vec<(f64, usize)>,
+}
+
+impl IndicatorAccumulator {
+    pub fn new(columns: usize, actuators: usize, joints: usize) -> IndicatorAccumulator {
+        let slots = 2 + 2 * actuators + 2 * joints;
+        IndicatorAccumulator {
+            columns,
+            actuators,
+            joints,
+            best: vec![(f64::NEG_INFINITY, usize::MAX); columns * slots],
+        }
+    }
+
+    fn slots(&self) -> usize {
+        2 + 2 * self.actuators + 2 * self.joints
+    }
+
+    fn offer(slot: &mut (f64, usize), v: f64, w: usize) {
+        if v > slot.0 || (v == slot.0 && w < slot.1) {
+            *slot = (v, w);
+        }
+    }
+
+    /// Adds task `w`'s rows: every column's row in the layout of [`StatsTable`], one after
+    /// the other.
+    pub fn add_rows(&mut self, w: usize, rows: &[f64]) {
+        let (na, nj) = (self.actuators, self.joints);
+        let width = 2 * na + 1 + 2 * nj;
+        let slots = self.slots();
+        for (best, r) in self
+            .best
+            .chunks_exact_mut(slots)
+            .zip(rows.chunks_exact(width))
+        {
+            let total: f64 = r[..na].iter().sum();
+            Self::offer(&mut best[0], total, w);
+            Self::offer(&mut best[1], r[2 * na], w);
+            for a in 0..na {
+                Self::offer(&mut best[2 + a], r[a], w);
+                Self::offer(&mut best[2 + na + a], r[na + a], w);
+            }
+            for j in 0..2 * nj {
+                Self::offer(&mut best[2 + 2 * na + j], r[2 * na + 1 + j], w);
+            }
+        }
+    }
+
+    /// Combines the maxima of two disjoint sets of tasks.
+    pub fn merge(mut self, other: &IndicatorAccumulator) -> IndicatorAccumulator {
+        for (a, b) in self.best.iter_mut().zip(&other.best) {
+            Self::offer(a, b.0, b.1);
+        }
+        self
+    }
+
+    /// The indicators of every column (all zero at task 0 when no task ran, like [`reduce`]).
+    pub fn finish(
+        &self,
+        actuator_names: &[String],
+        joint_names: &[String],
+        pair: impl Fn(usize) -> (usize, usize),
+    ) -> Vec<Indicators> {
+        let (na, nj) = (self.actuators, self.joints);
+        let slots = self.slots();
+        let get = |s: &(f64, usize)| {
+            if s.1 == usize::MAX {
+                let (i, j) = pair(0);
+                (0.0, [i, j])
+            } else {
+                let (i, j) = pair(s.1);
+                (s.0, [i, j])
+            }
+        };
+        self.best
+            .chunks_exact(slots)
+            .map(|b| {
+                let (qtr, qtr_task) = get(&b[0]);
+                let (qit, qit_task) = get(&b[1]);
+                Indicators {
+                    qtr,
+                    qtr_task,
+                    qit,
+                    qit_task,
+                    actuators: (0..na)
+                        .map(|a| {
+                            let (crt_rms, crt) = get(&b[2 + a]);
+                            let (cpt_peak, cpt) = get(&b[2 + na + a]);
+                            ActuatorIndicators {
+                                name: actuator_names[a].clone(),
+                                crt,
+                                crt_rms,
+                                cpt,
+                                cpt_peak,
+                            }
+                        })
+                        .collect(),
+                    joints: (0..nj)
+                        .map(|j| {
+                            let (force, force_task) = get(&b[2 + 2 * na + j]);
+                            let (moment, moment_task) = get(&b[2 + 2 * na + nj + j]);
+                            JointIndicators {
+                                name: joint_names[j].clone(),
+                                force,
+                                force_task,
+                                moment,
+                                moment_task,
+                            }
+                        })
+                        .collect(),
+                }
+            })
+            .collect()
+    }
+}

@@ -30,8 +30,8 @@ pub mod tasks;
 
 pub use error::{DynamicsError, FailureReason, TaskFailure};
 pub use evaluate::{
-    EvaluateOptions, EvaluationReport, Excluded, GridEvaluation, JointSeries, Series, evaluate,
-    evaluate_grid, task_series, task_series_with,
+    EvaluateOptions, EvaluationReport, Excluded, GridEvaluation, GridIndicators, JointSeries,
+    Series, evaluate, evaluate_grid, evaluate_grid_indicators, task_series, task_series_with,
 };
 pub use indicators::{ActuatorIndicators, Indicators, JointIndicators, TaskStats};
 pub use params::{Counterweight, ParameterSet, Spring, SpringSlot, Variant};

@@ -18,7 +18,7 @@ use counterpoise_balance::linear::solve;
 use counterpoise_balance::{Attachment, Status, VariantResult};
 use counterpoise_dynamics::params::{Counterweight, ParameterSet, Spring, Variant};
 use counterpoise_dynamics::runner::Workspace;
-use counterpoise_dynamics::{EvaluateOptions, Evaluator, Indicators, evaluate_grid};
+use counterpoise_dynamics::{EvaluateOptions, Evaluator, Indicators, evaluate_grid_indicators};
 use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -83,7 +83,26 @@ enum State {
     Running,
     Converged,
     Stopped,
+    /// Proved impossible (the reason names the binding constraint).
     Discarded(String),
+    /// Not built, not proved impossible.
+    Undecided(String),
+}
+
+/// Why a pass produced no candidate.
+#[derive(Clone, Debug, PartialEq)]
+enum Failure {
+    Discard(String),
+    Undecided(String),
+}
+
+impl Failure {
+    fn into_state(self) -> State {
+        match self {
+            Failure::Discard(r) => State::Discarded(r),
+            Failure::Undecided(r) => State::Undecided(r),
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -91,7 +110,10 @@ struct Candidate {
     x: DVector<f64>,
     cws: Vec<CwPhysical>,
     springs: Vec<SpringValues>,
+    /// 0 (the trivial bound) when the relaxation was not solved.
     lower_bound: f64,
+    /// Whether `lower_bound` is the relaxation's certified bound.
+    bound_certified: bool,
     working_value: f64,
     relaxation_status: crate::clarabel_map::ConicStatus,
     relaxation_iterations: u32,
@@ -116,6 +138,33 @@ pub fn optimise_all(
     variants: &[VariantResult],
     options: &OptimiseOptions,
 ) -> Vec<OptimisedVariant> {
+    optimise_all_timed(ctx, variants, options).0
+}
+
+/// Wall time of the stages of [`optimise_all`], seconds.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct StageTimings {
+    /// Relaxations, refinements and spring realizations of every pass.
+    pub solve: f64,
+    /// The all-task torque evaluations of the critical-task loop.
+    pub loop_grid: f64,
+    /// Spring choice by ΔR on the reaction tasks.
+    pub spring_choice: f64,
+    /// Final all-task evaluation (torques and joint reactions).
+    pub final_grid: f64,
+    /// Verification and records.
+    pub records: f64,
+    /// Passes of the critical-task loop.
+    pub passes: usize,
+}
+
+/// [`optimise_all`] with the wall time of each stage.
+pub fn optimise_all_timed(
+    ctx: &Context,
+    variants: &[VariantResult],
+    options: &OptimiseOptions,
+) -> (Vec<OptimisedVariant>, StageTimings) {
+    let mut timings = StageTimings::default();
     let mut runs: Vec<Run> = variants
         .iter()
         .filter(|v| v.status == Status::Balanced)
@@ -135,13 +184,17 @@ pub fn optimise_all(
             .collect::<BTreeSet<_>>()
             .into_iter()
             .collect();
+        timings.passes += 1;
+        let started = std::time::Instant::now();
         let (_, failures) = ctx.torques.get(&ctx.model, &ctx.tasks, &union);
         let failed: BTreeSet<usize> = failures.iter().map(|f| f.0).collect();
 
-        let outcomes: Vec<(usize, Result<Candidate, String>)> = active
+        let outcomes: Vec<(usize, Result<Candidate, Failure>)> = active
             .par_iter()
             .map(|&k| (k, step(ctx, &runs[k], &failed, options)))
             .collect();
+        timings.solve += started.elapsed().as_secs_f64();
+        let started = std::time::Instant::now();
         let mut evaluated: Vec<usize> = Vec::new();
         for (k, outcome) in outcomes {
             match outcome {
@@ -149,18 +202,20 @@ pub fn optimise_all(
                     runs[k].candidate = Some(c);
                     evaluated.push(k);
                 }
-                Err(reason) => runs[k].state = State::Discarded(reason),
+                Err(failure) => runs[k].state = failure.into_state(),
             }
         }
         if evaluated.is_empty() {
             continue;
         }
         let dyn_variants = candidate_variants(&runs, &evaluated);
-        let indicators = match grid_indicators(ctx, &dyn_variants, false) {
+        let indicators = grid_indicators(ctx, &dyn_variants, false);
+        timings.loop_grid += started.elapsed().as_secs_f64();
+        let indicators = match indicators {
             Ok(i) => i,
             Err(e) => {
                 for &k in &evaluated {
-                    runs[k].state = State::Discarded(format!("dynamics evaluation failed: {e}"));
+                    runs[k].state = State::Undecided(format!("dynamics evaluation failed: {e}"));
                 }
                 continue;
             }
@@ -198,7 +253,8 @@ pub fn optimise_all(
             run.state = State::Stopped;
         }
     }
-    finish(ctx, runs, options)
+    let out = finish(ctx, runs, options, &mut timings);
+    (out, timings)
 }
 
 fn new_run(ctx: &Context, v: &VariantResult, options: &OptimiseOptions) -> Run {
@@ -257,21 +313,28 @@ fn new_run(ctx: &Context, v: &VariantResult, options: &OptimiseOptions) -> Run {
 }
 
 /// One pass for one variant: relaxation, recovery, refinement, springs.
+///
+/// A relaxation proved infeasible discards the variant (the certificate), with the binding
+/// constraint named. Any other status short of `Solved` is not a verdict: the local search
+/// starts from the relaxation's last iterate, the bounds-only relaxation's point and the
+/// particular solution in turn, and the pass continues without a certified lower bound (the
+/// trivial bound 0 is recorded). If no start leads to a point within every bound, the variant
+/// is undecided, with the smallest violation found.
 fn step(
     ctx: &Context,
     run: &Run,
     failed: &BTreeSet<usize>,
     options: &OptimiseOptions,
-) -> Result<Candidate, String> {
+) -> Result<Candidate, Failure> {
     let problem = run
         .problem
         .as_ref()
         .expect("running variants have a problem");
     if let Some(w) = run.working.iter().find(|w| failed.contains(w)) {
-        return Err(format!(
+        return Err(Failure::Undecided(format!(
             "the kinematics of critical task {:?} failed",
             ctx.pair(*w)
-        ));
+        )));
     }
     let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
     let relaxed = solve_relaxation(
@@ -281,51 +344,87 @@ fn step(
         options.solver_iterations,
     );
     let status = relaxed.solution.status;
-    if status.is_infeasible() {
-        return Err(format!(
-            "the bounds and peak limits cannot all be met: the convex relaxation is infeasible \
-             (clarabel: {})",
-            status.name()
-        ));
-    }
-    if status != crate::clarabel_map::ConicStatus::Solved {
-        // Often a nearly infeasible problem: the bounds alone may prove it.
-        let bounds_only = solve_bounds_only(problem, options.solver_iterations);
-        if bounds_only.is_infeasible() {
-            return Err(format!(
-                "the bounds cannot all be met: the convex relaxation of the bounds alone is infeasible (clarabel: {}; with the objective and peak limits: {})",
-                bounds_only.name(),
-                status.name()
-            ));
-        }
-        return Err(format!(
-            "the relaxation was not solved (clarabel: {})",
-            status.name()
-        ));
-    }
-    let lower = relaxed.bound;
-    let dirs = counterweight_directions(problem);
-    let z_fixed = project_fixed(problem, &relaxed.z);
-    let z_relaxed = project_radius(problem, &z_fixed, &dirs).unwrap_or(z_fixed);
-    let scale = lower.abs().max(1e-9);
-    let (_, v0, viol0) = merit(problem, &tasks, options.objective, &z_relaxed, scale);
-    let gap_before = if viol0 <= FEASIBILITY_TOL && v0.is_finite() {
-        ((v0 - lower) / v0.max(1e-300)).max(0.0)
-    } else {
-        f64::INFINITY
+    let discard = || {
+        Failure::Discard(crate::diagnose::infeasibility_reason(
+            problem,
+            &tasks,
+            options.objective,
+            options.solver_iterations,
+            &ctx.unbalanced
+                .actuators
+                .iter()
+                .map(|a| a.name.clone())
+                .collect::<Vec<_>>(),
+            |w| ctx.pair(w),
+        ))
     };
-    let z = if gap_before <= options.gap_tolerance {
-        z_relaxed
-    } else {
-        let refined = refine(problem, &tasks, options.objective, &z_relaxed, &dirs, scale);
-        if !refined.feasible {
-            return Err(format!(
-                "no parameters found that meet every bound and peak limit (smallest relative \
-                 violation {:.2e})",
-                refined.violation
-            ));
+    if status.is_infeasible() {
+        return Err(discard());
+    }
+    let solved = status == crate::clarabel_map::ConicStatus::Solved;
+    let mut starts = vec![relaxed.z.clone()];
+    if !solved {
+        let bounds_only = solve_bounds_only(problem, options.solver_iterations);
+        if bounds_only.solution.status.is_infeasible() {
+            return Err(discard());
         }
-        refined.z
+        starts.push(bounds_only.z);
+        starts.push(DVector::zeros(problem.dim()));
+        starts.retain(|z| z.iter().all(|v| v.is_finite()));
+    }
+    let lower = if solved { relaxed.bound } else { 0.0 };
+    let dirs = counterweight_directions(problem);
+    let scale = if solved {
+        lower.abs().max(1e-9)
+    } else {
+        tasks
+            .iter()
+            .flat_map(|t| t.base.iter())
+            .fold(0.0f64, |a, &b| a.max(b.abs()))
+            .max(1e-9)
+    };
+    let mut smallest_violation = f64::INFINITY;
+    let mut chosen: Option<(DVector<f64>, f64)> = None;
+    for z0 in &starts {
+        let z_fixed = project_fixed(problem, z0);
+        let z_start = project_radius(problem, &z_fixed, &dirs).unwrap_or(z_fixed);
+        let (_, v0, viol0) = merit(problem, &tasks, options.objective, &z_start, scale);
+        let gap_before = if solved && viol0 <= FEASIBILITY_TOL && v0.is_finite() {
+            ((v0 - lower) / v0.max(1e-300)).max(0.0)
+        } else {
+            f64::INFINITY
+        };
+        if gap_before <= options.gap_tolerance {
+            chosen = Some((z_start, gap_before));
+            break;
+        }
+        let refined = refine(problem, &tasks, options.objective, &z_start, &dirs, scale);
+        if refined.feasible {
+            chosen = Some((refined.z, gap_before));
+            break;
+        }
+        smallest_violation = smallest_violation.min(refined.violation);
+    }
+    let Some((z, gap_before)) = chosen else {
+        let limits = if problem.peak_limits.iter().any(Option::is_some) {
+            " and peak limit"
+        } else {
+            ""
+        };
+        let relaxation = if solved {
+            String::new()
+        } else {
+            format!(
+                "; the convex relaxation could not be solved either (clarabel: {})",
+                status.name()
+            )
+        };
+        return Err(Failure::Undecided(format!(
+            "no parameters meeting every bound{limits} were found from {} starting points \
+             (smallest relative violation {smallest_violation:.2e}), but none are proved \
+             impossible{relaxation}",
+            starts.len()
+        )));
     };
     let x = problem.lifted(&z);
     let (mut springs, mut note) = realize_springs(
@@ -367,9 +466,9 @@ fn step(
                 })
                 .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)))
                 .map(|(_, _, s, xj)| (s, xj))
-                .ok_or(note)?
+                .ok_or(Failure::Undecided(note))?
         }
-        None => return Err(note),
+        None => return Err(Failure::Undecided(note)),
     };
     let cws = problem.cw_physical(&x_full);
     let value = problem
@@ -380,6 +479,7 @@ fn step(
         cws,
         springs,
         lower_bound: lower,
+        bound_certified: solved,
         working_value: value,
         relaxation_status: status,
         relaxation_iterations: relaxed.solution.iterations,
@@ -439,7 +539,10 @@ fn grid_indicators(
     let params = ParameterSet::from_variants(&ctx.model, variants).map_err(|e| e.to_string())?;
     let mut evaluate_options = EvaluateOptions::default();
     evaluate_options.reactions = reactions;
-    let grid = evaluate_grid(&ctx.model, &params, &evaluate_options).map_err(|e| e.to_string())?;
+    // Only the indicators are needed: the streaming evaluation keeps running maxima per
+    // variant instead of a table of every task and variant (tasks × variants × 33 values).
+    let grid = evaluate_grid_indicators(&ctx.model, &params, &evaluate_options)
+        .map_err(|e| e.to_string())?;
     Ok(grid.indicators)
 }
 
@@ -535,25 +638,58 @@ fn reaction_peaks(ctx: &Context, variants: &[Variant], tasks: &[usize]) -> Optio
     Some(total)
 }
 
-/// ΔR (paper Eqs. 17–21): weighted positive percentage increases of the peak joint reactions.
+/// ΔR (paper Eqs. 17–21, percent) of a variant whose peak joint reactions are `force`, `moment`
+/// (one per joint, in the unbalanced indicators' joint order), against the unbalanced robot.
+///
+/// There is one definition of ΔR in the workspace: [`counterpoise_report::delta_r`], which the
+/// ranking uses. Calling it here means the springs are chosen by the very quantity they are
+/// ranked by. In particular a joint that carries no load in the unbalanced robot counts with
+/// its weighted term `γ·ΔF = (F − F_UB)/Σ F_UB · 100` (the continuous extension of Eq. 19 at
+/// `F_UB = 0`), so a spring that loads a previously idle joint is penalised.
+///
+/// `None` when the unbalanced robot has no joint reactions or a value is not finite.
 pub fn delta_r(unbalanced: &Indicators, force: &[f64], moment: &[f64]) -> Option<f64> {
-    if unbalanced.joints.is_empty() {
+    use counterpoise_report::JointReaction;
+    if unbalanced.joints.is_empty()
+        || force.len() != unbalanced.joints.len()
+        || moment.len() != unbalanced.joints.len()
+    {
         return None;
     }
-    let sf: f64 = unbalanced.joints.iter().map(|j| j.force).sum();
-    let sm: f64 = unbalanced.joints.iter().map(|j| j.moment).sum();
-    let mut total = 0.0;
-    for (k, j) in unbalanced.joints.iter().enumerate() {
-        if j.force > 0.0 && sf > 0.0 {
-            let d = ((force[k] - j.force) / j.force * 100.0).max(0.0);
-            total += j.force / sf * d;
-        }
-        if j.moment > 0.0 && sm > 0.0 {
-            let d = ((moment[k] - j.moment) / j.moment * 100.0).max(0.0);
-            total += j.moment / sm * d;
-        }
-    }
-    Some(total)
+    let reference: Vec<JointReaction> = unbalanced
+        .joints
+        .iter()
+        .map(|j| JointReaction {
+            name: j.name.clone(),
+            force: j.force,
+            moment: j.moment,
+        })
+        .collect();
+    let variant: Vec<JointReaction> = unbalanced
+        .joints
+        .iter()
+        .zip(force.iter().zip(moment))
+        .map(|(j, (&force, &moment))| JointReaction {
+            name: j.name.clone(),
+            force,
+            moment,
+        })
+        .collect();
+    counterpoise_report::delta_r(&reference, &variant)
+        .ok()
+        .map(|d| d.value)
+}
+
+/// The spring option to keep: the one with the lowest ΔR (paper Proc-9 ranks spring-only
+/// variants by ΔR, so the optimiser keeps the realization that ranks best); options without a
+/// score come last, ties go to the earliest option (the realization from the lifted optimum is
+/// first). `None` for no options.
+pub fn lowest_delta_r(scores: &[Option<f64>]) -> Option<usize> {
+    (0..scores.len()).min_by(|&a, &b| {
+        let sa = scores[a].unwrap_or(f64::INFINITY);
+        let sb = scores[b].unwrap_or(f64::INFINITY);
+        sa.total_cmp(&sb).then(a.cmp(&b))
+    })
 }
 
 /// Interval of coordinate `k` (others held) over which the convex lifted bounds hold.
@@ -641,7 +777,13 @@ fn free_parameters(
 type SpringChoice = (Vec<SpringValues>, DVector<f64>, Option<f64>);
 
 /// Spring choice by ΔR, final all-task evaluation, verification and the output records.
-fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<OptimisedVariant> {
+fn finish(
+    ctx: &Context,
+    mut runs: Vec<Run>,
+    options: &OptimiseOptions,
+    timings: &mut StageTimings,
+) -> Vec<OptimisedVariant> {
+    let started = std::time::Instant::now();
     // Reaction tasks: the critical tasks plus the unbalanced joints' critical tasks.
     let mut joint_tasks = BTreeSet::new();
     for j in &ctx.unbalanced.joints {
@@ -697,13 +839,7 @@ fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<O
                     .collect(),
                 None => vec![None; variants.len()],
             };
-            let best = (0..options_found.len())
-                .min_by(|&a, &b| {
-                    let sa = scores[a].unwrap_or(f64::INFINITY);
-                    let sb = scores[b].unwrap_or(f64::INFINITY);
-                    sa.total_cmp(&sb).then(a.cmp(&b))
-                })
-                .unwrap_or(0);
+            let best = lowest_delta_r(&scores).unwrap_or(0);
             let (s, x) = options_found.swap_remove(best);
             Some((s, x, scores[best]))
         })
@@ -714,6 +850,8 @@ fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<O
             c.x = x.clone();
         }
     }
+    timings.spring_choice = started.elapsed().as_secs_f64();
+    let started = std::time::Instant::now();
     // Final evaluation over all tasks, batched.
     let finals: Vec<usize> = (0..runs.len())
         .filter(|&k| {
@@ -735,11 +873,16 @@ fn finish(ctx: &Context, mut runs: Vec<Run>, options: &OptimiseOptions) -> Vec<O
         });
     }
 
-    runs.into_iter()
+    timings.final_grid = started.elapsed().as_secs_f64();
+    let started = std::time::Instant::now();
+    let out = runs
+        .into_iter()
         .zip(choices)
         .zip(indicators_of)
         .map(|((run, choice), ind)| record(ctx, run, choice.and_then(|c| c.2), ind, options))
-        .collect()
+        .collect();
+    timings.records = started.elapsed().as_secs_f64();
+    out
 }
 
 fn record(
@@ -769,11 +912,20 @@ fn record(
         verification: None,
         indicators: None,
     };
-    if let State::Discarded(reason) = &run.state {
-        out.reason = Some(reason.clone());
-        return out;
+    match &run.state {
+        State::Discarded(reason) => {
+            out.reason = Some(reason.clone());
+            return out;
+        }
+        State::Undecided(reason) => {
+            out.status = OptimisedStatus::Undecided;
+            out.reason = Some(reason.clone());
+            return out;
+        }
+        _ => {}
     }
     let (Some(problem), Some(cand)) = (run.problem.as_ref(), run.candidate.as_ref()) else {
+        out.status = OptimisedStatus::Undecided;
         out.reason = Some("no candidate parameters were produced".into());
         return out;
     };
@@ -807,51 +959,64 @@ fn record(
         })
         .collect();
     out.free_parameters = free_parameters(problem, &run.free_components, &cand.x);
-    out.lower_bound = Some(cand.lower_bound);
+    out.lower_bound = cand.bound_certified.then_some(cand.lower_bound);
     let ind = match indicators {
         Some(Ok(i)) => i,
         Some(Err(e)) => {
+            out.status = OptimisedStatus::Undecided;
             out.reason = Some(format!("final dynamics evaluation failed: {e}"));
             return out;
         }
         None => {
+            out.status = OptimisedStatus::Undecided;
             out.reason = Some("no final evaluation".into());
             return out;
         }
     };
     let objective = objective_of(&ind, options.objective);
     out.objective = Some(objective);
-    out.gap = Some(((objective - cand.lower_bound) / objective.abs().max(1e-300)).max(0.0));
+    out.gap = out
+        .lower_bound
+        .map(|lb| ((objective - lb) / objective.abs().max(1e-300)).max(0.0));
     let report = verify(problem, &ctx.checks, &cand.cws, &cand.springs, &ind);
     out.residual = Some(report.balance_residual);
     let passed = report.passed;
     if !passed {
+        // A peak over a limit at the optimised point is a verified violation (discarded);
+        // a balance or bound check that fails is a numerical shortfall (undecided).
         let mut why = Vec::new();
-        if !report.balance_passed {
-            why.push(format!(
-                "balance residual {:.2e} exceeds 1e-9",
-                report.balance_residual
-            ));
-        }
-        if !report.bounds_passed {
-            why.push(format!(
-                "a bound is exceeded (relative {:.2e})",
-                report.bound_excess
-            ));
-        }
         if !report.peaks_passed {
-            for p in &report.peaks {
+            for (n, p) in report.peaks.iter().enumerate() {
                 if let Some(l) = p.limit
                     && p.peak > l
                 {
+                    let task = ind.actuators.get(n).map_or(String::new(), |a| {
+                        format!(" on task {}→{}", a.cpt[0], a.cpt[1])
+                    });
                     why.push(format!(
-                        "{} peaks at {:.3} N·m over all tasks (limit {l})",
+                        "{} peaks at {:.2} N·m{task} (limit {l} N·m)",
                         p.actuator, p.peak
                     ));
                 }
             }
         }
-        out.reason = Some(format!("verification failed: {}", why.join("; ")));
+        if !report.balance_passed || !report.bounds_passed {
+            out.status = OptimisedStatus::Undecided;
+            if !report.balance_passed {
+                why.push(format!(
+                    "the optimised parameters balance only to a relative residual of {:.2e} \
+                     (1e-9 required)",
+                    report.balance_residual
+                ));
+            }
+            if !report.bounds_passed {
+                why.push(format!(
+                    "the optimised parameters exceed a bound by {:.2e} (relative)",
+                    report.bound_excess
+                ));
+            }
+        }
+        out.reason = Some(why.join("; "));
     } else {
         out.status = OptimisedStatus::Feasible;
         if run.state == State::Stopped {

@@ -24,6 +24,7 @@
 pub mod clarabel_map;
 pub mod context;
 pub mod critical;
+pub mod diagnose;
 pub mod error;
 pub mod overrides;
 pub mod problem;
@@ -36,7 +37,10 @@ pub mod verify;
 
 pub use clarabel_map::ConicStatus;
 pub use context::Context;
-pub use critical::{OptimiseOptions, delta_r, objective_of, optimise_all, optimise_variant};
+pub use critical::{
+    OptimiseOptions, StageTimings, delta_r, lowest_delta_r, objective_of, optimise_all,
+    optimise_all_timed, optimise_variant,
+};
 pub use error::OptimiseError;
 pub use overrides::{BoundsTable, CounterweightBounds, ElementBounds, SpringBounds};
 pub use problem::Objective;

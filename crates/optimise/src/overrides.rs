@@ -42,6 +42,24 @@ pub struct SpringBounds {
     pub anchor_a: [f64; 2],
     /// |b|, m.
     pub anchor_b: [f64; 2],
+    /// Per body-frame axis (x, y, z) of anchor a, `[lo, hi]` in m (infinite when free): a box,
+    /// a half-space per coordinate, or a fixed anchor (`lo = hi` on every axis).
+    pub box_a: [[f64; 2]; 3],
+    /// The same for anchor b, in the frame of the other body (or the base).
+    pub box_b: [[f64; 2]; 3],
+}
+
+/// No constraint on an anchor coordinate.
+pub const FREE_AXIS: [f64; 2] = [f64::NEG_INFINITY, f64::INFINITY];
+
+impl SpringBounds {
+    /// Whether any anchor coordinate is bounded.
+    pub fn has_box(&self) -> bool {
+        self.box_a
+            .iter()
+            .chain(&self.box_b)
+            .any(|r| r[0].is_finite() || r[1].is_finite())
+    }
 }
 
 /// Bounds of one catalogue element.
@@ -77,12 +95,23 @@ impl BoundsTable {
                     stiffness: defaults.stiffness,
                     anchor_a: defaults.anchor_a,
                     anchor_b: defaults.anchor_b,
+                    box_a: [FREE_AXIS; 3],
+                    box_b: [FREE_AXIS; 3],
                 }),
             })
             .collect();
         let mut errors = Vec::new();
+        // The last override of each entry, to name it when the entry's constraints conflict.
+        let mut last: Vec<Option<usize>> = vec![None; entries.len()];
         for (i, value) in balancing.overrides.iter().enumerate() {
-            apply(model, catalogue, &mut entries, i, value, &mut errors);
+            if let Some(k) = apply(model, catalogue, &mut entries, i, value, &mut errors) {
+                last[k] = Some(i);
+            }
+        }
+        for (k, e) in entries.iter().enumerate() {
+            if let (ElementBounds::Spring(b), Some(i)) = (e, last[k]) {
+                consistent_anchors(catalogue, k, i, b, &mut errors);
+            }
         }
         if errors.is_empty() {
             Ok(BoundsTable { entries })
@@ -185,29 +214,64 @@ fn apply(
     i: usize,
     value: &serde_json::Value,
     errors: &mut Vec<String>,
-) {
+) -> Option<usize> {
     let path = format!("balancing.overrides[{i}]");
     let Some(object) = value.as_object() else {
         errors.push(format!(
             "{path}: expected an object like {{\"element\": \"m4\", \"radius\": [0.2, 0.2]}}"
         ));
-        return;
+        return None;
     };
     let Some(element) = object.get("element") else {
         errors.push(format!(
             "{path}.element: missing (which element the override applies to)"
         ));
-        return;
+        return None;
     };
     let entry = match resolve(model, catalogue, element) {
         Ok(k) => k,
         Err(e) => {
             errors.push(format!("{path}.element: {e}"));
-            return;
+            return None;
         }
     };
     for (key, v) in object {
         if key == "element" {
+            continue;
+        }
+        if let (
+            ElementBounds::Spring(b),
+            "anchor_a_box" | "anchor_b_box" | "anchor_a_fixed" | "anchor_b_fixed",
+        ) = (&mut entries[entry], key.as_str())
+        {
+            let parsed = if key.ends_with("_box") {
+                anchor_box(v)
+            } else {
+                fixed_anchor(v)
+            };
+            match parsed {
+                Ok(r) if key.starts_with("anchor_a") => b.box_a = r,
+                Ok(r) => b.box_b = r,
+                Err(e) => errors.push(format!("{path}.{key}: {e}")),
+            }
+            continue;
+        }
+        let known = match &entries[entry] {
+            ElementBounds::Counterweight(_) => ["mass", "radius"].contains(&key.as_str()),
+            ElementBounds::Spring(_) => {
+                ["stiffness", "anchor_a", "anchor_b"].contains(&key.as_str())
+            }
+        };
+        if !known {
+            errors.push(match &entries[entry] {
+                ElementBounds::Counterweight(_) => format!(
+                    "{path}.{key}: unknown field for a counterweight (expected mass, radius)"
+                ),
+                ElementBounds::Spring(_) => format!(
+                    "{path}.{key}: unknown field for a spring (expected stiffness, anchor_a, \
+                     anchor_b, anchor_a_box, anchor_b_box, anchor_a_fixed, anchor_b_fixed)"
+                ),
+            });
             continue;
         }
         let r = match range(v) {
@@ -223,12 +287,123 @@ fn apply(
             (ElementBounds::Spring(b), "stiffness") => b.stiffness = r,
             (ElementBounds::Spring(b), "anchor_a") => b.anchor_a = r,
             (ElementBounds::Spring(b), "anchor_b") => b.anchor_b = r,
-            (ElementBounds::Counterweight(_), _) => errors.push(format!(
-                "{path}.{key}: unknown field for a counterweight (expected mass, radius)"
-            )),
-            (ElementBounds::Spring(_), _) => errors.push(format!(
-                "{path}.{key}: unknown field for a spring (expected stiffness, anchor_a, anchor_b)"
-            )),
+            _ => unreachable!("unknown fields are reported above"),
+        }
+    }
+    Some(entry)
+}
+
+/// `{"x": [lo, hi], "y": [lo, null], …}`: per-axis bounds of an anchor in its body frame, m;
+/// `null` leaves that side free (a half-space), a missing axis is free.
+fn anchor_box(value: &serde_json::Value) -> Result<[[f64; 2]; 3], String> {
+    let object = value
+        .as_object()
+        .ok_or("expected an object like {\"x\": [0, 0.5], \"y\": [-0.1, null]}")?;
+    let mut out = [FREE_AXIS; 3];
+    for (key, v) in object {
+        let axis = match key.as_str() {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            _ => return Err(format!("unknown axis `{key}` (expected x, y, z)")),
+        };
+        let arr = v
+            .as_array()
+            .filter(|a| a.len() == 2)
+            .ok_or_else(|| format!("{key}: expected [lo, hi] (null for no bound)"))?;
+        let side = |x: &serde_json::Value, free: f64| -> Result<f64, String> {
+            if x.is_null() {
+                return Ok(free);
+            }
+            let v = x
+                .as_f64()
+                .ok_or_else(|| format!("{key}: expected numbers or null"))?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(format!("{key}: bounds must be finite (null for none)"))
+            }
+        };
+        let lo = side(&arr[0], f64::NEG_INFINITY)?;
+        let hi = side(&arr[1], f64::INFINITY)?;
+        if lo > hi {
+            return Err(format!("{key}: lo > hi ([{lo}, {hi}])"));
+        }
+        out[axis] = [lo, hi];
+    }
+    Ok(out)
+}
+
+/// `[x, y, z]`: a fixed anchor in its body frame, m.
+fn fixed_anchor(value: &serde_json::Value) -> Result<[[f64; 2]; 3], String> {
+    let arr = value
+        .as_array()
+        .filter(|a| a.len() == 3)
+        .ok_or("expected [x, y, z] (m, body frame)")?;
+    let mut out = [FREE_AXIS; 3];
+    for (k, v) in arr.iter().enumerate() {
+        let x = v
+            .as_f64()
+            .filter(|x| x.is_finite())
+            .ok_or("expected three finite numbers")?;
+        out[k] = [x, x];
+    }
+    Ok(out)
+}
+
+/// Contradictions between a spring's anchor constraints: a box that excludes 0 on an axis
+/// outside the springs' plane (the coordinate is 0 there), or a box entirely outside the
+/// distance range `|a| ≤ hi` (a fixed anchor outside its bounds, for one). Errors name the
+/// element.
+fn consistent_anchors(
+    catalogue: &Catalogue,
+    entry: usize,
+    index: usize,
+    b: &SpringBounds,
+    errors: &mut Vec<String>,
+) {
+    let Element::Spring { axes_a, axes_b, .. } = &catalogue.entries[entry].element else {
+        return;
+    };
+    let label = &catalogue.entries[entry].label;
+    let path = format!("balancing.overrides[{index}]");
+    for (name, bx, axes, dist) in [
+        ("anchor_a", &b.box_a, axes_a, b.anchor_a),
+        ("anchor_b", &b.box_b, axes_b, b.anchor_b),
+    ] {
+        for (k, r) in bx.iter().enumerate() {
+            if !axes.contains(&k) && (r[0] > 0.0 || r[1] < 0.0) {
+                errors.push(format!(
+                    "{path}.{name}: {label}'s anchors lie in a plane where the {} \
+                     coordinate is 0, outside its box [{}, {}]",
+                    ["x", "y", "z"][k],
+                    r[0],
+                    r[1]
+                ));
+            }
+        }
+        // Nearest point of the box to the origin must be within the distance bound.
+        let nearest: f64 = bx
+            .iter()
+            .map(|r| {
+                if r[0] > 0.0 {
+                    r[0]
+                } else if r[1] < 0.0 {
+                    -r[1]
+                } else {
+                    0.0
+                }
+            })
+            .map(|d| d * d)
+            .sum::<f64>()
+            .sqrt();
+        if nearest > dist[1] * (1.0 + 1e-12) {
+            errors.push(format!(
+                "{path}.{name}: every point of {label}'s {name} box is at least \
+                 {nearest} m from the body origin, beyond the bound |{}| ≤ {} m",
+                &name[7..],
+                dist[1]
+            ));
         }
     }
 }

@@ -312,7 +312,7 @@ impl VariantProblem {
     /// Relative violations of the convex lifted bounds at `x` (each ≤ 0 when met): masses,
     /// radii (both sides: `r_lo·m ≤ |μ| ≤ r_hi·m`), stiffnesses and the anchor upper bounds
     /// `|K a| ≤ a_hi K`, `|K b| ≤ b_hi K` (the anchor lower bounds are checked on the realized
-    /// springs).
+    /// springs; so are the anchor boxes, which the relaxation meets only to its tolerance).
     pub fn bound_violations(&self, x: &DVector<f64>) -> Vec<f64> {
         let mut v = Vec::new();
         for c in &self.counterweights {

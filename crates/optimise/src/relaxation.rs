@@ -13,6 +13,9 @@
 //!   mass range;
 //! - `|r| ≥ r_lo`, `|a| ≥ a_lo`, `|b| ≥ b_lo` and spring realizability (`K·W = αβᵀ`) are dropped.
 //!
+//! Anchor boxes from the case's overrides (`lo ≤ a_i ≤ hi` per body-frame axis) are linear in
+//! the lifted variables, `lo·K ≤ (K a)_i ≤ hi·K`, and kept exactly.
+//!
 //! The bounds that are convex in the lifted variables are kept exactly: masses, `|μ| ≤ r_hi·m`,
 //! stiffnesses, `|K a| ≤ a_hi·K`, `|K b| ≤ b_hi·K`, `|K a_k b_l| ≤ a_hi·b_hi·K`; the peak limits are linear inequalities at
 //! every working-set sample. The objective is RMS* (`min ‖t‖/√N`, `t_n ≥` the RMS of actuator
@@ -273,6 +276,27 @@ pub fn solve_relaxation(
             let a_scale = natural[s.column + 1] / big_k;
             cp.soc(&k.scaled(s.bounds.anchor_a[1] / a_scale), &alpha);
         }
+        // Anchor boxes: lo ≤ a_i ≤ hi is lo·K ≤ K·a_i ≤ hi·K, linear since K > 0 (exact).
+        for (bx, axes, first) in [
+            (&s.bounds.box_a, &s.axes_a, s.column + 1),
+            (&s.bounds.box_b, &s.axes_b, s.column + 1 + na),
+        ] {
+            for (i, &axis) in axes.iter().enumerate() {
+                let [lo, hi] = bx[axis];
+                let coord = xn(first + i);
+                let c_scale = natural[first + i] / big_k;
+                if lo.is_finite() {
+                    let mut e = coord.clone();
+                    e.add_scaled(&k, -lo / c_scale);
+                    cp.nonneg(&e);
+                }
+                if hi.is_finite() {
+                    let mut e = k.scaled(hi / c_scale);
+                    e.add_scaled(&coord, -1.0);
+                    cp.nonneg(&e);
+                }
+            }
+        }
         if nb > 0 {
             let b_scale = natural[s.column + 1 + na] / big_k;
             cp.soc(&k.scaled(s.bounds.anchor_b[1] / b_scale), &beta);
@@ -385,11 +409,6 @@ pub fn solve_relaxation(
 
 /// The relaxation of the bounds alone (no tasks, no objective): its infeasibility proves that no
 /// parameters within the bounds balance the variant.
-pub fn solve_bounds_only(
-    problem: &VariantProblem,
-    max_iter: u32,
-) -> crate::clarabel_map::ConicStatus {
+pub fn solve_bounds_only(problem: &VariantProblem, max_iter: u32) -> Relaxed {
     solve_relaxation(problem, &[], Objective::Minimax, max_iter)
-        .solution
-        .status
 }

@@ -9,12 +9,17 @@ use crate::clarabel_map::ConicStatus;
 use crate::problem::Objective;
 use crate::verify::VerificationReport;
 
-/// `feasible` or `discarded` (paper Proc-6).
+/// `feasible`, `discarded` (paper Proc-6) or `undecided`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum OptimisedStatus {
     Feasible,
+    /// Certified: the relaxation of the exact constraints is infeasible, or the optimised
+    /// parameters were verified to violate a peak limit over all tasks.
     Discarded,
+    /// No parameters within the bounds were found, but none were proved impossible either
+    /// (a numerical failure, or a local search that gave up): the reason says which.
+    Undecided,
 }
 
 /// An optimised counterweight (SI).

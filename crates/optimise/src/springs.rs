@@ -194,6 +194,23 @@ fn residual(
                 (0..n).map(|i| (u + offset + i, unit[i] / l)).collect(),
             );
         }
+        // Anchor boxes per body-frame axis.
+        for (bx, axes, offset, reach) in [
+            (&s.bounds.box_a, &s.axes_a, 1, s.bounds.anchor_a[1]),
+            (&s.bounds.box_b, &s.axes_b, 1 + na, s.bounds.anchor_b[1]),
+        ] {
+            let l = reach.max(1e-3);
+            for (i, &axis) in axes.iter().enumerate() {
+                let [lo, hi] = bx[axis];
+                let c = y[u + offset + i];
+                if lo.is_finite() {
+                    hinge((lo - c) / l, vec![(u + offset + i, -1.0 / l)]);
+                }
+                if hi.is_finite() {
+                    hinge((c - hi) / l, vec![(u + offset + i, 1.0 / l)]);
+                }
+            }
+        }
     }
     for (c, &u) in problem.counterweights.iter().zip(&lay.cw_start) {
         let (big_m, big_r) = cw_scales(c);
@@ -420,6 +437,16 @@ pub fn realize_springs(
                     for i in 0..n {
                         y0[u + offset + i] = dir[i] / dn * len;
                     }
+                }
+            }
+            // Start inside the anchor boxes.
+            for (bx, axes, offset) in [
+                (&s.bounds.box_a, &s.axes_a, 1),
+                (&s.bounds.box_b, &s.axes_b, 1 + na),
+            ] {
+                for (i, &axis) in axes.iter().enumerate() {
+                    let [lo, hi] = bx[axis];
+                    y0[u + offset + i] = y0[u + offset + i].clamp(lo, hi);
                 }
             }
         }

@@ -80,6 +80,20 @@ pub fn bound_excess(problem: &VariantProblem, cws: &[CwPhysical], springs: &[Spr
         worst = worst.max(excess(v.stiffness, s.bounds.stiffness));
         worst = worst.max(excess(norm(&v.anchor_a), s.bounds.anchor_a));
         worst = worst.max(excess(norm(&v.anchor_b), s.bounds.anchor_b));
+        for (bx, anchor, reach) in [
+            (&s.bounds.box_a, &v.anchor_a, s.bounds.anchor_a[1]),
+            (&s.bounds.box_b, &v.anchor_b, s.bounds.anchor_b[1]),
+        ] {
+            let scale = reach.abs().max(1e-12);
+            for (r, &c) in bx.iter().zip(anchor) {
+                if r[0].is_finite() {
+                    worst = worst.max((r[0] - c) / scale);
+                }
+                if r[1].is_finite() {
+                    worst = worst.max((c - r[1]) / scale);
+                }
+            }
+        }
     }
     worst
 }

@@ -129,7 +129,7 @@ fn the_papers_eleven_sets() {
                     assert!(!ind.joints.is_empty());
                 }
             }
-            OptimisedStatus::Discarded => {
+            OptimisedStatus::Discarded | OptimisedStatus::Undecided => {
                 assert!(v.reason.as_ref().is_some_and(|r| !r.is_empty()));
             }
         }

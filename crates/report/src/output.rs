@@ -73,7 +73,8 @@ pub fn write_atomic(dir: &Path, name: &str, contents: &[u8]) -> Result<PathBuf, 
 /// Returns the paths written. Call [`RunResults::finalize`] first.
 pub fn write_outputs(dir: &Path, results: &RunResults) -> Result<Vec<PathBuf>, OutputError> {
     fs::create_dir_all(dir).map_err(io(dir))?;
-    let json = serde_json::to_vec_pretty(results).map_err(OutputError::Serialise)?;
+    // Compact: at Dmax 3 pretty-printing doubled the file (indentation of nested arrays).
+    let json = serde_json::to_vec(results).map_err(OutputError::Serialise)?;
     let mut written = vec![write_atomic(dir, RESULTS_JSON, &json)?];
     written.extend(write_reports(dir, results)?);
     Ok(written)

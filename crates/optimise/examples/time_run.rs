@@ -1,0 +1,121 @@
+//! Timing of the palletizer run by phase, the way `counterpoise run` does it: Phase 1 (the
+//! unbalanced robot over all tasks, with reactions), the balance search, the optimiser's context,
+//! and each stage of the optimisation (relaxations and refinements, the loop's all-task torque
+//! evaluations, the spring choice, the final all-task evaluation, the records).
+//!
+//! ```text
+//! cargo run --release -p counterpoise-optimise --example time_run -- [dmax] [runs]
+//! ```
+//!
+//! Defaults: Dmax = 3, 3 runs. Prints each run's phases, then per phase the median and the range
+//! over the runs, and the verdict counts of the last run.
+
+use std::time::Instant;
+
+use counterpoise_balance::{
+    Catalogue, SearchOptions, Status, catalogue_options, mechanism_energy, realization_hints,
+    search,
+};
+use counterpoise_dynamics::params::ParameterSet;
+use counterpoise_dynamics::{EvaluateOptions, evaluate_grid};
+use counterpoise_model::Case;
+use counterpoise_optimise::{Context, OptimiseOptions, optimise_all_timed};
+
+fn median_range(mut v: Vec<f64>) -> String {
+    v.sort_by(f64::total_cmp);
+    format!(
+        "{:.2} s [{:.2}–{:.2}]",
+        v[v.len() / 2],
+        v[0],
+        v[v.len() - 1]
+    )
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let dmax: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(3);
+    let runs: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3);
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../cases/palletizer.json");
+    let model = Case::from_path(&path).expect("the palletizer case loads");
+    let names = [
+        "phase 1 (UB, reactions)",
+        "balance search",
+        "context",
+        "optimisation: solve",
+        "optimisation: loop grid",
+        "optimisation: spring choice",
+        "optimisation: final grid",
+        "optimisation: records",
+        "total",
+    ];
+    let mut table: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+    let mut last = Vec::new();
+    for run in 0..runs {
+        let start = Instant::now();
+        let t = Instant::now();
+        let mut ub = evaluate_grid(
+            &model,
+            &ParameterSet::unbalanced(&model),
+            &EvaluateOptions::default(),
+        )
+        .expect("phase 1");
+        let phase1 = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let energy = mechanism_energy(&model);
+        let report = search(
+            &energy,
+            Catalogue::build(&energy, &catalogue_options(&model)),
+            SearchOptions {
+                dmax,
+                hints: realization_hints(&model),
+            },
+        );
+        let searched = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let ctx = Context::new(&model, Some(ub.indicators.swap_remove(0))).expect("context");
+        let context = t.elapsed().as_secs_f64();
+        let (out, stages) = optimise_all_timed(&ctx, &report.variants, &OptimiseOptions::default());
+        let total = start.elapsed().as_secs_f64();
+        let row = [
+            phase1,
+            searched,
+            context,
+            stages.solve,
+            stages.loop_grid,
+            stages.spring_choice,
+            stages.final_grid,
+            stages.records,
+            total,
+        ];
+        eprintln!(
+            "run {run}: {} ({} passes)",
+            names
+                .iter()
+                .zip(row)
+                .map(|(n, s)| format!("{n} {s:.2} s"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            stages.passes
+        );
+        for (col, s) in table.iter_mut().zip(row) {
+            col.push(s);
+        }
+        let balanced = report
+            .variants
+            .iter()
+            .filter(|v| v.status == Status::Balanced)
+            .count();
+        last = vec![(balanced, out)];
+    }
+    println!("palletizer, Dmax = {dmax}, {runs} runs (median [min–max]):");
+    for (n, col) in names.iter().zip(table) {
+        println!("  {n:<30} {}", median_range(col));
+    }
+    if let Some((balanced, out)) = last.pop() {
+        let feasible = out.iter().filter(|v| v.is_feasible()).count();
+        println!(
+            "{balanced} balanced variants: {feasible} feasible, {} not",
+            out.len() - feasible
+        );
+    }
+}
