@@ -3,7 +3,7 @@
 //! Problems are written as `min cᵀx` subject to blocks of rows `A x + s = b`, `s ∈ K`, with `K`
 //! a zero cone (equalities), the nonnegative orthant (`Ax ≤ b`), second-order cones
 //! (`s₀ ≥ ‖s₁…‖`) or power cones (`s₀^α s₁^(1−α) ≥ |s₂|`). Rows are built as sparse maps and
-//! converted once. Only `Solved` counts as success (DESIGN §3): every other status is returned
+//! converted once. Only `Solved` counts as success (docs/design.md §3): every other status is returned
 //! by name so that the output says exactly why a variant was discarded.
 
 use std::collections::BTreeMap;

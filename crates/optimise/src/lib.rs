@@ -1,4 +1,4 @@
-//! Optimisation of balanced variants (DESIGN §2 Phase 2, §3; paper Eqs. 11–14, Proc-5…8).
+//! Optimisation of balanced variants (docs/design.md §2 Phase 2, §3; paper Eqs. 11–14, Proc-5…8).
 //!
 //! Each balanced variant is a family of parameter sets `x = x_p + N z` (the balance search's
 //! lifted solution set). This crate picks the member that minimises the energy estimate RMS*

@@ -2,7 +2,7 @@
 //! counterweights' lifted inertial parameters.
 //!
 //! Once a variant is balanced its total potential energy is constant, so gravity and springs
-//! cancel exactly and the motor torque is inertial only (DESIGN §3): `τ(t) = τ₀(t) + Σ_c Y_c(t) π_c`
+//! cancel exactly and the motor torque is inertial only (docs/design.md §3): `τ(t) = τ₀(t) + Σ_c Y_c(t) π_c`
 //! where `τ₀` is the inertial torque of the bodies and all payloads and `π_c` the 10 lifted
 //! parameters `(m, m·r, I_o)` of counterweight `c` on its body. The inertial parts come from the
 //! dynamics crate's evaluator on a *gravity-free* copy of the model; payloads that the balance
