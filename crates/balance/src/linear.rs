@@ -140,7 +140,18 @@ pub fn solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
         Some(exact) => {
             let solution = exact.solve(elements);
             if solution.consistent() {
-                from_exact(basis, &solution)
+                // Where confident floating point agrees with the exact facts its SVD basis spans
+                // the same family; the optimiser was tuned on that basis, so keep it. Where it
+                // is wrong or ambiguous, the exact family decides.
+                let numeric = numeric_solve(basis, elements);
+                if numeric.ambiguity.is_none()
+                    && numeric.consistent
+                    && numeric.rank == solution.rank()
+                {
+                    numeric
+                } else {
+                    from_exact(basis, &solution)
+                }
             } else {
                 // The least-squares residual is only informative; consistency is the exact fact.
                 let mut numeric = numeric_solve(basis, elements);
@@ -211,78 +222,174 @@ fn column_norms(matrix: &DMatrix<f64>) -> DVector<f64> {
     )
 }
 
-/// Solves one variant's balance system in floating point (faer's SVD, with the ambiguous zone
-/// of the module documentation).
-pub fn numeric_solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
-    let (matrix, offsets) = basis.system(elements);
-    let b = &basis.unbalanced;
-    let (rows, cols) = matrix.shape();
-    let column_scale = column_norms(&matrix);
-    let scaled = faer::Mat::from_fn(rows, cols, |i, j| matrix[(i, j)] / column_scale[j]);
-    let mut ambiguity = None;
+/// One SVD's reading of a variant: its least-scaled-norm solution, free directions and rank.
+struct SvdFamily {
+    particular: DVector<f64>,
+    nullspace: DMatrix<f64>,
+    rank: usize,
+    residual: f64,
+}
+
+/// Builds the family from singular triplets `(σ_k, u_k, v_k)` of the column-scaled matrix.
+fn family_from_svd(
+    matrix: &DMatrix<f64>,
+    b: &DVector<f64>,
+    column_scale: &DVector<f64>,
+    triplets: &[(f64, DVector<f64>, DVector<f64>)],
+) -> SvdFamily {
+    let cols = matrix.ncols();
+    let sigma_max = triplets.iter().fold(0.0f64, |a, t| a.max(t.0));
     let mut y = DVector::zeros(cols);
     let mut null_columns = Vec::new();
     let mut rank = 0;
-    match scaled.svd() {
-        Ok(svd) => {
-            let (u, v) = (svd.U(), svd.V());
-            let sigma: Vec<f64> = svd.S().column_vector().iter().copied().collect();
-            let sigma_max = sigma.iter().fold(0.0f64, |a, &s| a.max(s));
-            for k in 0..cols {
-                let s = sigma.get(k).copied().unwrap_or(0.0);
-                let v_k = DVector::from_fn(cols, |j, _| v[(j, k)]);
-                if sigma_max > 0.0 && s > RANK_TOL * sigma_max {
-                    rank += 1;
-                    let coefficient = (0..rows).map(|i| -u[(i, k)] * b[i]).sum::<f64>() / s;
-                    y += v_k * coefficient;
-                } else {
-                    if sigma_max > 0.0 && s > ZERO_TOL * sigma_max && ambiguity.is_none() {
-                        ambiguity = Some(format!(
-                            "a singular value of {:.1e} relative to the largest is neither clearly \
-                             zero (< {ZERO_TOL:.0e}) nor clearly not (> {RANK_TOL:.0e})",
-                            s / sigma_max
-                        ));
-                    }
-                    null_columns.push(v_k);
-                }
-            }
-        }
-        Err(e) => {
-            ambiguity = Some(format!("the SVD did not converge ({e:?})"));
+    for (s, u, v) in triplets {
+        if sigma_max > 0.0 && *s > RANK_TOL * sigma_max {
+            rank += 1;
+            let coefficient = -(0..matrix.nrows()).map(|i| u[i] * b[i]).sum::<f64>() / s;
+            y += v * coefficient;
+        } else {
+            null_columns.push(v.clone());
         }
     }
-    let particular = y.component_mul(&column_scale.map(|s| 1.0 / s));
-    let nullspace = if null_columns.is_empty() {
+    let particular = y.component_div(column_scale);
+    let mut nullspace = if null_columns.is_empty() {
         DMatrix::zeros(cols, 0)
     } else {
-        let mut n = DMatrix::from_columns(&null_columns);
-        for j in 0..cols {
-            let s = column_scale[j];
-            n.row_mut(j).scale_mut(1.0 / s);
-        }
-        n
+        DMatrix::from_columns(&null_columns)
     };
+    for j in 0..cols {
+        nullspace.row_mut(j).scale_mut(1.0 / column_scale[j]);
+    }
     let b_norm = b.norm();
-    let residual_vector = &matrix * &particular + b;
+    let residual_vector = matrix * &particular + b;
     let residual = if b_norm > 0.0 {
         residual_vector.norm() / b_norm
     } else {
         residual_vector.norm()
     };
-    if ambiguity.is_none() && residual > CONSISTENCY_TOL && residual < INCONSISTENCY_TOL {
+    SvdFamily {
+        particular,
+        nullspace,
+        rank,
+        residual,
+    }
+}
+
+/// The singular triplets of the column-scaled matrix by faer, every right singular vector
+/// included (σ = 0 past the rows); `Err` when the SVD fails.
+fn faer_triplets(
+    matrix: &DMatrix<f64>,
+    column_scale: &DVector<f64>,
+) -> Result<Vec<(f64, DVector<f64>, DVector<f64>)>, String> {
+    let (rows, cols) = matrix.shape();
+    let scaled = faer::Mat::from_fn(rows, cols, |i, j| matrix[(i, j)] / column_scale[j]);
+    let svd = scaled
+        .svd()
+        .map_err(|e| format!("the SVD did not converge ({e:?})"))?;
+    let (u, v) = (svd.U(), svd.V());
+    let sigma: Vec<f64> = svd.S().column_vector().iter().copied().collect();
+    Ok((0..cols)
+        .map(|k| {
+            let s = sigma.get(k).copied().unwrap_or(0.0);
+            let u_k = DVector::from_fn(rows, |i, _| if k < rows { u[(i, k)] } else { 0.0 });
+            (s, u_k, DVector::from_fn(cols, |j, _| v[(j, k)]))
+        })
+        .collect())
+}
+
+/// The same triplets by nalgebra (padded so that the thin SVD yields every right vector).
+fn nalgebra_triplets(
+    matrix: &DMatrix<f64>,
+    column_scale: &DVector<f64>,
+) -> Vec<(f64, DVector<f64>, DVector<f64>)> {
+    let (rows, cols) = matrix.shape();
+    let mut scaled = DMatrix::zeros(rows.max(cols), cols);
+    for j in 0..cols {
+        let column = matrix.column(j) / column_scale[j];
+        scaled.view_mut((0, j), (rows, 1)).copy_from(&column);
+    }
+    let svd = scaled.svd(true, true);
+    let u = svd.u.expect("SVD computed with U");
+    let v_t = svd.v_t.expect("SVD computed with Vᵀ");
+    (0..svd.singular_values.len())
+        .map(|k| {
+            (
+                svd.singular_values[k],
+                u.column(k).rows(0, rows).into_owned(),
+                v_t.row(k).transpose(),
+            )
+        })
+        .collect()
+}
+
+/// Solves one variant's balance system in floating point. faer's SVD decides — rank,
+/// consistency and the ambiguous zone of the module documentation. The family handed on is
+/// nalgebra's SVD basis of the span when that one agrees (same rank, and it solves the system
+/// when faer says it is solvable): the optimiser's local searches were tuned on that basis;
+/// otherwise faer's.
+pub fn numeric_solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
+    let (matrix, offsets) = basis.system(elements);
+    let b = &basis.unbalanced;
+    let column_scale = column_norms(&matrix);
+    let triplets = match faer_triplets(&matrix, &column_scale) {
+        Ok(t) => t,
+        Err(reason) => {
+            let family = family_from_svd(
+                &matrix,
+                b,
+                &column_scale,
+                &nalgebra_triplets(&matrix, &column_scale),
+            );
+            return LinearSolution {
+                consistent: false,
+                matrix,
+                offsets,
+                residual: family.residual,
+                particular: family.particular,
+                nullspace: family.nullspace,
+                rank: family.rank,
+                column_scale,
+                ambiguity: Some(reason),
+            };
+        }
+    };
+    let sigma_max = triplets.iter().fold(0.0f64, |a, t| a.max(t.0));
+    let mut ambiguity = triplets
+        .iter()
+        .map(|t| t.0)
+        .find(|&s| sigma_max > 0.0 && s <= RANK_TOL * sigma_max && s > ZERO_TOL * sigma_max)
+        .map(|s| {
+            format!(
+                "a singular value of {:.1e} relative to the largest is neither clearly zero \
+                 (< {ZERO_TOL:.0e}) nor clearly not (> {RANK_TOL:.0e})",
+                s / sigma_max
+            )
+        });
+    let decided = family_from_svd(&matrix, b, &column_scale, &triplets);
+    let residual = decided.residual;
+    let consistent = residual <= CONSISTENCY_TOL;
+    if ambiguity.is_none() && !consistent && residual < INCONSISTENCY_TOL {
         ambiguity = Some(format!(
             "the relative residual {residual:.1e} is neither clearly zero (< {CONSISTENCY_TOL:.0e}) \
              nor clearly not (> {INCONSISTENCY_TOL:.0e})"
         ));
     }
+    let tuned = family_from_svd(
+        &matrix,
+        b,
+        &column_scale,
+        &nalgebra_triplets(&matrix, &column_scale),
+    );
+    let agrees = tuned.rank == decided.rank && (!consistent || tuned.residual <= CONSISTENCY_TOL);
+    let family = if agrees { tuned } else { decided };
     LinearSolution {
-        consistent: residual <= CONSISTENCY_TOL,
+        consistent,
         matrix,
         offsets,
         residual,
-        particular,
-        nullspace,
-        rank,
+        particular: family.particular,
+        nullspace: family.nullspace,
+        rank: family.rank,
         column_scale,
         ambiguity,
     }

@@ -168,16 +168,20 @@ impl Ring for BigInt {
 
 /// Eliminates `[A | r]`, given as rows of `columns + 1` integers.
 pub fn eliminate(rows: &[Vec<BigInt>], columns: usize) -> Echelon {
+    if let Some(echelon) = eliminate_small(rows, columns) {
+        return echelon;
+    }
+    gauss_jordan(rows.to_vec(), columns).expect("big integers do not overflow")
+}
+
+/// The elimination in checked `i128` alone: `None` when an entry does not fit or a step would
+/// overflow.
+fn eliminate_small(rows: &[Vec<BigInt>], columns: usize) -> Option<Echelon> {
     let small: Option<Vec<Vec<i128>>> = rows
         .iter()
         .map(|row| row.iter().map(|v| i128::try_from(v).ok()).collect())
         .collect();
-    if let Some(small) = small
-        && let Some(echelon) = gauss_jordan(small, columns)
-    {
-        return echelon;
-    }
-    gauss_jordan(rows.to_vec(), columns).expect("big integers do not overflow")
+    gauss_jordan(small?, columns)
 }
 
 /// Divides a row by the gcd of its entries and makes its pivot positive.
@@ -280,6 +284,24 @@ mod tests {
         assert_eq!(e.particular(), vec![q(5, 1), q(1, 2), q(0, 1)]);
         // Null direction: z = 1, y = 1, x = −5.
         assert_eq!(e.nullspace(), vec![vec![q(-5, 1), q(1, 1), q(1, 1)]]);
+    }
+
+    #[test]
+    fn rows_end_in_lowest_terms_with_positive_pivots_on_the_small_path() {
+        // 2x + 4y = 6 and −3x + 9y = 0: solved in i128, each row divided by its content.
+        let rows = big(&[&[2, 4, 6], &[-3, 9, 0]]);
+        let small = eliminate_small(&rows, 2).expect("small numbers stay in i128");
+        assert_eq!(small, eliminate(&rows, 2));
+        for (row, &p) in small.rows.iter().zip(&small.pivots) {
+            let content = row.iter().fold(BigInt::zero(), |g, v| Integer::gcd(&g, v));
+            assert_eq!(content, BigInt::from(1), "{row:?}");
+            assert!(Signed::is_positive(&row[p]), "{row:?}");
+        }
+        // x = 6/5·… : 2x + 4y = 6, −3x + 9y = 0 ⇒ x = 3y, 10y = 6 ⇒ y = 3/5, x = 9/5.
+        assert_eq!(small.particular(), vec![q(9, 5), q(3, 5)]);
+        // Entries beyond i128 leave the small path.
+        let huge = BigInt::from(2).pow(130);
+        assert!(eliminate_small(&[vec![huge.clone(), huge]], 1).is_none());
     }
 
     #[test]
