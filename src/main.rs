@@ -77,6 +77,21 @@ enum Command {
         #[arg(long, default_value_t = 0.01)]
         resolution: f64,
     },
+    /// Write a case file from a URDF robot description (bodies, joints, actuators, a default
+    /// balancing section and task grid).
+    ImportUrdf {
+        /// The robot description (URDF).
+        urdf: PathBuf,
+        /// Case file to write (default: standard output).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Link fixed to the ground (default: the URDF's root link).
+        #[arg(long)]
+        base: Option<String>,
+        /// Last link of the chain: joints off the base-tip path are frozen at 0.
+        #[arg(long)]
+        tip: Option<String>,
+    },
     /// Regenerate report.html, report.md and ranking.csv from DIR/results.json.
     Report {
         /// A directory written by `run`.
@@ -173,6 +188,16 @@ fn run(cli: Cli) -> ExitCode {
             },
         ),
         Command::Report { dir } => commands::report(&dir),
+        Command::ImportUrdf {
+            urdf,
+            out,
+            base,
+            tip,
+        } => commands::import_urdf::run(
+            &urdf,
+            out.as_deref(),
+            counterpoise_urdf::ImportOptions { base, tip },
+        ),
     };
     match result {
         Ok(code) => code,

@@ -2,6 +2,7 @@
 
 pub mod check;
 pub mod evaluate;
+pub mod import_urdf;
 pub mod run;
 pub mod variants;
 
