@@ -22,8 +22,9 @@ pub struct ImportOptions {
     pub tip: Option<String>,
 }
 
-/// Most grid points of the default task grid: 3 per joint while the product stays within it.
-pub const GRID_POINTS: usize = 243;
+/// Most grid points of the default task grid: 3 per joint while the product stays within it
+/// (81 points are 3,240 moves: `check` of a 7-joint arm stays well under a second).
+pub const GRID_POINTS: usize = 81;
 
 #[derive(Serialize)]
 pub struct CaseDoc {
@@ -98,6 +99,10 @@ impl Lump {
         let mass: f64 = self.parts.iter().map(|p| p.0).sum();
         if mass == 0.0 {
             return (0.0, Vector3::zeros(), Matrix3::zeros());
+        }
+        if let [(m, c, i)] = self.parts.as_slice() {
+            // One part: as written, without the rounding of a weighted mean.
+            return (*m, *c, *i);
         }
         let com = self
             .parts
@@ -374,8 +379,8 @@ pub fn build(robot: &Robot, tree: &Tree, options: &ImportOptions) -> Result<Case
     })
 }
 
-/// 3 points per joint over its limits, the last joints getting fewer (2, then 1) while the grid
-/// has more than [`GRID_POINTS`] points.
+/// 3 points per joint over its limits, the last joints getting fewer (2, then 1: the middle of
+/// the range) while the grid has more than [`GRID_POINTS`] points.
 fn default_grid(joints: &[(String, [f64; 2])]) -> BTreeMap<String, Value> {
     let mut counts = vec![3usize; joints.len()];
     let mut k = joints.len();
@@ -388,7 +393,15 @@ fn default_grid(joints: &[(String, [f64; 2])]) -> BTreeMap<String, Value> {
     joints
         .iter()
         .zip(counts)
-        .map(|((name, [lo, hi]), n)| (name.clone(), json!([lo, hi, n])))
+        .map(|((name, [lo, hi]), n)| {
+            let axis = if n == 1 {
+                let mid = 0.5 * (lo + hi);
+                json!([mid, mid, 1])
+            } else {
+                json!([lo, hi, n])
+            };
+            (name.clone(), axis)
+        })
         .collect()
 }
 

@@ -13,6 +13,7 @@
 
 pub mod build;
 pub mod error;
+mod layout;
 pub mod parse;
 pub mod steps;
 pub mod tree;
@@ -32,7 +33,7 @@ pub fn import(urdf: &str, options: &ImportOptions) -> Result<Imported, UrdfError
     let robot = parse::parse(urdf)?;
     let tree = tree::Tree::build(&robot)?;
     let doc = build::build(&robot, &tree, options)?;
-    let json = serde_json::to_string_pretty(&doc).expect("a case document serialises") + "\n";
+    let json = layout::layout(&serde_json::to_string(&doc).expect("a case document serialises"));
     match counterpoise_model::Case::from_json_str(&json) {
         Ok(model) => Ok(Imported { json, model }),
         Err(errors) => Err(UrdfError::Case(errors.lines().join("\n"))),
