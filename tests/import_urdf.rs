@@ -17,7 +17,10 @@ fn imported_two_link_arm_is_the_example_case_and_checks_exactly() {
     assert_success(&out);
     let written = std::fs::read_to_string(&out_path).unwrap();
     let example = std::fs::read_to_string(root().join("cases/two_link_urdf.json")).unwrap();
-    assert_eq!(written, example, "cases/two_link_urdf.json is the importer's output");
+    assert_eq!(
+        written, example,
+        "cases/two_link_urdf.json is the importer's output"
+    );
     // Without --out the case goes to standard output.
     let out = counterpoise(&["import-urdf", "crates/urdf/tests/data/two_link.urdf"]);
     assert_success(&out);
@@ -40,7 +43,15 @@ fn imported_two_link_arm_is_the_example_case_and_checks_exactly() {
     let variants = doc["variants"].as_array().unwrap();
     let pair = variants
         .iter()
-        .find(|v| v["elements"].as_array().unwrap().iter().map(|e| e["label"].as_str().unwrap()).collect::<Vec<_>>() == ["m1", "m2"])
+        .find(|v| {
+            v["elements"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|e| e["label"].as_str().unwrap())
+                .collect::<Vec<_>>()
+                == ["m1", "m2"]
+        })
         .unwrap();
     assert_eq!(pair["status"], "balanced", "{pair}");
 }
@@ -49,11 +60,19 @@ fn imported_two_link_arm_is_the_example_case_and_checks_exactly() {
 fn malformed_urdf_fails_naming_the_element() {
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.urdf");
-    let text = std::fs::read_to_string(root().join("crates/urdf/tests/data/two_link.urdf")).unwrap();
-    std::fs::write(&bad, text.replace("<child link=\"link2\"/>", "<child link=\"link7\"/>")).unwrap();
+    let text =
+        std::fs::read_to_string(root().join("crates/urdf/tests/data/two_link.urdf")).unwrap();
+    std::fs::write(
+        &bad,
+        text.replace("<child link=\"link2\"/>", "<child link=\"link7\"/>"),
+    )
+    .unwrap();
     let out = counterpoise(&["import-urdf", bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
     let err = stderr(&out);
-    assert!(err.contains("joint `elbow`.child: child link `link7` does not exist"), "{err}");
+    assert!(
+        err.contains("joint `elbow`.child: child link `link7` does not exist"),
+        "{err}"
+    );
     assert!(stdout(&out).is_empty());
 }

@@ -185,9 +185,10 @@ fn range(robot: &Robot, j: usize) -> Result<[f64; 2], UrdfError> {
 /// Builds the case document.
 pub fn build(robot: &Robot, tree: &Tree, options: &ImportOptions) -> Result<CaseDoc, UrdfError> {
     let find_link = |name: &str, option: &str| {
-        tree.link_index.get(name).copied().ok_or_else(|| {
-            UrdfError::invalid(format!("--{option}"), format!("no link `{name}`"))
-        })
+        tree.link_index
+            .get(name)
+            .copied()
+            .ok_or_else(|| UrdfError::invalid(format!("--{option}"), format!("no link `{name}`")))
     };
     let base = match &options.base {
         Some(name) => find_link(name, "base")?,
@@ -310,7 +311,9 @@ pub fn build(robot: &Robot, tree: &Tree, options: &ImportOptions) -> Result<Case
             let placement = if joint.kind == JointType::Fixed {
                 at_joint
             } else {
-                let value = robot.joints[j].limit.map_or(0.0, |l| 0f64.clamp(l.lower, l.upper));
+                let value = robot.joints[j]
+                    .limit
+                    .map_or(0.0, |l| 0f64.clamp(l.lower, l.upper));
                 at_joint.then(&steps::frozen_motion(
                     joint.axis,
                     joint.kind.is_angular(),

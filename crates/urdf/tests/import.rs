@@ -109,7 +109,10 @@ fn two_link_arm_actuators_grid_and_balancing_follow_the_urdf() {
     assert!(model.actuators.iter().all(|a| a.ratio == 1.0));
     let balancing = model.balancing.as_ref().unwrap();
     assert_eq!(balancing.peak_limits, vec![Some(120.0), Some(40.0)]);
-    assert_eq!(balancing.counterweights.as_ref().unwrap().bodies, vec![0, 1]);
+    assert_eq!(
+        balancing.counterweights.as_ref().unwrap().bodies,
+        vec![0, 1]
+    );
     let springs = balancing.springs.as_ref().unwrap();
     assert!(springs.include_base);
     assert_eq!(springs.pairs().len(), 3, "K10, K20, K21");
@@ -147,21 +150,32 @@ fn balance_search_finds_the_counterweight_pair_on_the_imported_two_link_arm() {
     // x; the one on link 1 cancels link 1 and everything it carries at the elbow.
     let w = pair.witness.as_ref().unwrap();
     let (cw1, cw2) = (&w.counterweights[0], &w.counterweights[1]);
-    assert!((cw2.mass * cw2.offset[0] + 2.5 * 0.3).abs() < 1e-9, "{cw2:?}");
+    assert!(
+        (cw2.mass * cw2.offset[0] + 2.5 * 0.3).abs() < 1e-9,
+        "{cw2:?}"
+    );
     let carried = 2.5 + cw2.mass;
     assert!(
         (cw1.mass * cw1.offset[0] + 4.0 * 0.4 + carried * 0.8).abs() < 1e-9,
         "{cw1:?}"
     );
     // A single counterweight on link 1 cannot hold link 2 at every elbow angle.
-    let alone = report.variants.iter().find(|v| labels(v) == ["m1"]).unwrap();
+    let alone = report
+        .variants
+        .iter()
+        .find(|v| labels(v) == ["m1"])
+        .unwrap();
     assert_ne!(alone.status, Status::Balanced);
 }
 
 #[test]
 fn fixed_joints_merge_mass_com_and_inertia_by_the_parallel_axis_theorem() {
     let model = imported("fixed_merge.urdf").model;
-    assert_eq!(model.bodies.len(), 1, "bracket, motor and flange merge into arm");
+    assert_eq!(
+        model.bodies.len(),
+        1,
+        "bracket, motor and flange merge into arm"
+    );
     let arm = &model.bodies[0];
     // Hand calculation (see fixed_merge.urdf): arm 2 kg at (0.5, 0, 0); bracket 1 kg at
     // (1, 0, 0.1), inertia diag(0.01, 0.03, 0.02) turned a quarter about z → diag(0.03, 0.01,
@@ -169,7 +183,11 @@ fn fixed_joints_merge_mass_com_and_inertia_by_the_parallel_axis_theorem() {
     // diag(0.006, 0.005, 0.004). Total 4 kg at (0.75, 0, 0.1); the offsets from it add
     // xx 0.02 + 0 + 0.04, yy 0.145 + 0.0625 + 0.1025, zz 0.125 + 0.0625 + 0.0625, xz −0.05 − 0.05.
     assert_eq!(arm.mass, 4.0);
-    assert!((arm.com - Vector3::new(0.75, 0.0, 0.1)).norm() < 1e-15, "{}", arm.com);
+    assert!(
+        (arm.com - Vector3::new(0.75, 0.0, 0.1)).norm() < 1e-15,
+        "{}",
+        arm.com
+    );
     let expected = Matrix3::new(0.106, 0.0, -0.1, 0.0, 0.525, 0.0, -0.1, 0.0, 0.474);
     assert!(
         (arm.inertia_com - expected).norm() < 1e-14,
@@ -230,7 +248,11 @@ fn quarter_turns_are_written_exactly_and_other_angles_as_decimals() {
         "<origin xyz=\"0.8 0 0\" rpy=\"3.1415926538 0 0\"/>",
     );
     let imported = import(&near, &ImportOptions::default()).unwrap();
-    assert!(imported.json.contains("\"rot_x\": \"pi\""), "{}", imported.json);
+    assert!(
+        imported.json.contains("\"rot_x\": \"pi\""),
+        "{}",
+        imported.json
+    );
     assert!(counterpoise_model::exact_mechanism(&imported.model).is_ok());
 }
 
@@ -274,7 +296,10 @@ fn malformed_urdf_is_refused_naming_the_element() {
         error_of(&unknown),
         "joint `elbow`.parent: parent link `link9` does not exist"
     );
-    let two_roots = two.replace("<link name=\"world\"/>", "<link name=\"world\"/><link name=\"spare\"/>");
+    let two_roots = two.replace(
+        "<link name=\"world\"/>",
+        "<link name=\"world\"/><link name=\"spare\"/>",
+    );
     assert!(
         error_of(&two_roots).contains("two root links, `world` and `spare`"),
         "{}",
@@ -286,20 +311,39 @@ fn malformed_urdf_is_refused_naming_the_element() {
          <joint name=\"ab\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/></joint>\
          <joint name=\"ba\" type=\"fixed\"><parent link=\"b\"/><child link=\"a\"/></joint></robot>",
     );
-    assert!(error_of(&cycle).contains("form a cycle"), "{}", error_of(&cycle));
+    assert!(
+        error_of(&cycle).contains("form a cycle"),
+        "{}",
+        error_of(&cycle)
+    );
     let closed = two.replace(
         "</robot>",
         "<joint name=\"loop\" type=\"fixed\"><parent link=\"world\"/><child link=\"link2\"/></joint></robot>",
     );
     assert!(
-        error_of(&closed).starts_with("joint `loop`: link `link2` is already the child of joint `elbow`"),
+        error_of(&closed)
+            .starts_with("joint `loop`: link `link2` is already the child of joint `elbow`"),
         "{}",
         error_of(&closed)
     );
-    let floating = two.replace("type=\"revolute\">\n    <parent link=\"link1\"", "type=\"floating\">\n    <parent link=\"link1\"");
-    assert!(error_of(&floating).starts_with("joint `elbow`.type: `floating`"), "{}", error_of(&floating));
-    let no_limit = two.replace("<limit lower=\"-2.5\" upper=\"2.5\" effort=\"40\" velocity=\"2\"/>", "");
-    assert!(error_of(&no_limit).starts_with("joint `elbow`.limit:"), "{}", error_of(&no_limit));
+    let floating = two.replace(
+        "type=\"revolute\">\n    <parent link=\"link1\"",
+        "type=\"floating\">\n    <parent link=\"link1\"",
+    );
+    assert!(
+        error_of(&floating).starts_with("joint `elbow`.type: `floating`"),
+        "{}",
+        error_of(&floating)
+    );
+    let no_limit = two.replace(
+        "<limit lower=\"-2.5\" upper=\"2.5\" effort=\"40\" velocity=\"2\"/>",
+        "",
+    );
+    assert!(
+        error_of(&no_limit).starts_with("joint `elbow`.limit:"),
+        "{}",
+        error_of(&no_limit)
+    );
     let mimic = two.replace(
         "<limit lower=\"-2.5\"",
         "<mimic joint=\"shoulder\" multiplier=\"0.5\"/><limit lower=\"-2.5\"",
@@ -328,4 +372,117 @@ fn a_linear_mimic_follows_its_joint() {
     let t = 0.4_f64;
     let v = G * (4.0 * (0.5 + 0.4 * t.sin()) + 2.5 * (0.5 + 0.8 * t.sin() + 0.3 * (3.0 * t).sin()));
     assert!((potential(&model, &[t]) - v).abs() < 1e-12);
+}
+
+/// The potential energy by the URDF's own forward kinematics (nalgebra isometries, joint after
+/// joint from the parsed file): an independent second method for the imported poses.
+fn urdf_potential(urdf: &str, q_of: &dyn Fn(&str) -> f64) -> f64 {
+    use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion};
+    let robot = counterpoise_urdf::parse::parse(urdf).unwrap();
+    let iso = |o: &counterpoise_urdf::parse::Origin| {
+        Isometry3::from_parts(
+            Translation3::new(o.xyz[0], o.xyz[1], o.xyz[2]),
+            UnitQuaternion::from_euler_angles(o.rpy[0], o.rpy[1], o.rpy[2]),
+        )
+    };
+    let mut world: std::collections::HashMap<String, Isometry3<f64>> = Default::default();
+    let child_links: Vec<&str> = robot.joints.iter().map(|j| j.child.as_str()).collect();
+    let root = robot
+        .links
+        .iter()
+        .find(|l| !child_links.contains(&l.name.as_str()))
+        .unwrap();
+    world.insert(root.name.clone(), Isometry3::identity());
+    while world.len() < robot.links.len() {
+        for j in &robot.joints {
+            let Some(parent) = world.get(&j.parent).copied() else {
+                continue;
+            };
+            let axis = Unit::new_normalize(Vector3::from(j.axis));
+            let motion = match j.kind {
+                counterpoise_urdf::parse::JointType::Fixed => Isometry3::identity(),
+                counterpoise_urdf::parse::JointType::Prismatic => Isometry3::from_parts(
+                    Translation3::from(axis.into_inner() * q_of(&j.name)),
+                    UnitQuaternion::identity(),
+                ),
+                _ => Isometry3::from_parts(
+                    Translation3::identity(),
+                    UnitQuaternion::from_axis_angle(&axis, q_of(&j.name)),
+                ),
+            };
+            world.insert(j.child.clone(), parent * iso(&j.origin) * motion);
+        }
+    }
+    robot
+        .links
+        .iter()
+        .filter_map(|l| l.inertial.map(|i| (l, i)))
+        .map(|(l, i)| {
+            let com = world[&l.name] * nalgebra::Point3::from(i.origin.xyz);
+            i.mass * G * com.z
+        })
+        .sum()
+}
+
+#[test]
+fn imported_energy_matches_urdf_forward_kinematics_on_every_test_robot() {
+    // The two-link arm on a slide along the tilted axis (0.6, 0, 0.8) instead of its shoulder.
+    let slide = data("two_link.urdf")
+        .replace(
+            "name=\"shoulder\" type=\"revolute\"",
+            "name=\"shoulder\" type=\"prismatic\"",
+        )
+        .replacen("<axis xyz=\"0 -1 0\"/>", "<axis xyz=\"0.6 0 0.8\"/>", 1);
+    let robots = [
+        ("two_link.urdf", data("two_link.urdf")),
+        ("three_dof.urdf", data("three_dof.urdf")),
+        ("seven_dof.urdf", data("seven_dof.urdf")),
+        ("fixed_merge.urdf", data("fixed_merge.urdf")),
+        ("slide", slide),
+    ];
+    for (name, text) in robots {
+        let model = import(&text, &ImportOptions::default()).unwrap().model;
+        for q in configurations(&model, 25) {
+            let value = |joint: &str| {
+                model
+                    .coordinates
+                    .iter()
+                    .position(|c| c.name == joint)
+                    .map_or(0.0, |k| q[k])
+            };
+            let expected = urdf_potential(&text, &value);
+            let got = potential(&model, &q);
+            assert!(
+                (got - expected).abs() < 1e-11,
+                "{name} at {q:?}: {got} vs {expected}"
+            );
+        }
+        if name == "slide" {
+            assert_eq!(
+                model.coordinates[0].kind,
+                counterpoise_symbolic::VarKind::Length
+            );
+        }
+    }
+}
+
+#[test]
+fn seven_dof_arm_is_exact_with_the_hand_merged_into_the_last_link() {
+    let imported = imported("seven_dof.urdf");
+    let model = &imported.model;
+    assert_eq!(model.bodies.len(), 7);
+    assert_eq!(model.coordinates.len(), 7);
+    // link7 0.74 kg at z 0.08 and the hand 0.73 kg at z 0.107 + 0.02 (turned about z only).
+    let last = &model.bodies[6];
+    assert!((last.mass - 1.47).abs() < 1e-15);
+    let z = (0.74 * 0.08 + 0.73 * 0.127) / 1.47;
+    assert!((last.com.z - z).abs() < 1e-15, "{}", last.com);
+    // Every rpy is a quarter turn: no decimal angle in the file, the exact decision runs.
+    assert!(!imported.json.contains("1.5707963"));
+    assert!(counterpoise_model::exact_mechanism(model).is_ok());
+    // 3 points on the first four joints, the wrist at mid-range: 81 points.
+    let grid = &model.tasks.as_ref().unwrap().grid;
+    let points: usize = grid.iter().map(|a| a.n).product();
+    assert_eq!(points, 81);
+    assert_eq!((grid[6].from, grid[6].n), (0.0, 1));
 }
