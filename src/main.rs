@@ -59,6 +59,10 @@ enum Command {
         /// File for the time series of --task (JSON).
         #[arg(long, requires = "task")]
         series: Option<PathBuf>,
+        /// Inverse dynamics at the states of FILE (a JSON array of {"q", "qd", "qdd"}):
+        /// actuator forces, motor torques and potential energy, as JSON.
+        #[arg(long, value_name = "FILE", conflicts_with_all = ["task", "series", "samples", "no_reactions"])]
+        states: Option<PathBuf>,
     },
     /// The whole case study: unbalanced indicators, balance search, optimisation, ranking,
     /// reports (results.json, report.html, report.md, ranking.csv).
@@ -157,11 +161,17 @@ fn run(cli: Cli) -> ExitCode {
         Command::Variants { case, dmax, json } => commands::variants::run(&case, dmax, json),
         Command::Evaluate {
             case,
+            states: Some(states),
+            ..
+        } => commands::states::run(&case, &states),
+        Command::Evaluate {
+            case,
             json,
             samples,
             no_reactions,
             task,
             series,
+            states: None,
         } => commands::evaluate::run(
             &case,
             commands::evaluate::Options {

@@ -76,3 +76,133 @@ fn malformed_urdf_fails_naming_the_element() {
     );
     assert!(stdout(&out).is_empty());
 }
+
+/// Runs `evaluate CASE --states` on `states` and returns the parsed output.
+fn states_of(case: &str, states: &serde_json::Value) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("states.json");
+    std::fs::write(&path, states.to_string()).unwrap();
+    let out = counterpoise(&["evaluate", case, "--states", path.to_str().unwrap()]);
+    assert_success(&out);
+    serde_json::from_str(&stdout(&out)).unwrap()
+}
+
+#[test]
+fn states_give_the_closed_form_inverse_dynamics_of_the_two_link_arm() {
+    // Planar arm (angles measured from the horizontal x axis, gravity −z):
+    // τ = M(q) q̈ + C(q, q̇) q̇ + g(q) with link inertias about y I1 = 0.2133, I2 = 0.075.
+    let (m1, m2, l1, c1, c2, i1, i2, g) = (4.0, 2.5, 0.8, 0.4, 0.3, 0.2133, 0.075, 9.81_f64);
+    let states = serde_json::json!([
+        { "q": [0.3, -0.4], "qd": [0.5, 1.0], "qdd": [-0.7, 2.0] },
+        { "q": [-1.2, 2.1], "qd": [-1.5, 0.25], "qdd": [0.4, -3.0] },
+        { "q": [0.9, 0.2] }
+    ]);
+    let doc = states_of("cases/two_link_urdf.json", &states);
+    assert_eq!(doc["actuators"], serde_json::json!(["shoulder", "elbow"]));
+    for (k, s) in states.as_array().unwrap().iter().enumerate() {
+        let v = |key: &str, i: usize| s.get(key).map_or(0.0, |x| x[i].as_f64().unwrap());
+        let (q1, q2, d1, d2, a1, a2) = (
+            v("q", 0),
+            v("q", 1),
+            v("qd", 0),
+            v("qd", 1),
+            v("qdd", 0),
+            v("qdd", 1),
+        );
+        let m11 = i1 + i2 + m1 * c1 * c1 + m2 * (l1 * l1 + c2 * c2 + 2.0 * l1 * c2 * q2.cos());
+        let m12 = i2 + m2 * (c2 * c2 + l1 * c2 * q2.cos());
+        let m22 = i2 + m2 * c2 * c2;
+        let h = m2 * l1 * c2 * q2.sin();
+        let g1 = g * ((m1 * c1 + m2 * l1) * q1.cos() + m2 * c2 * (q1 + q2).cos());
+        let g2 = g * m2 * c2 * (q1 + q2).cos();
+        let tau = [
+            m11 * a1 + m12 * a2 - h * (2.0 * d1 * d2 + d2 * d2) + g1,
+            m12 * a1 + m22 * a2 + h * d1 * d1 + g2,
+        ];
+        let potential =
+            g * (m1 * (0.5 + c1 * q1.sin()) + m2 * (0.5 + l1 * q1.sin() + c2 * (q1 + q2).sin()));
+        let got = &doc["states"][k];
+        for a in 0..2 {
+            let f = got["actuator_forces"][a].as_f64().unwrap();
+            assert!(
+                (f - tau[a]).abs() < 1e-9 * (1.0 + tau[a].abs()),
+                "state {k}: {f} vs {}",
+                tau[a]
+            );
+            // ratio 1: the motor torque is the actuator force
+            assert_eq!(got["motor_torques"][a], got["actuator_forces"][a]);
+        }
+        let v = got["potential_energy"].as_f64().unwrap();
+        assert!(
+            (v - potential).abs() < 1e-12,
+            "state {k}: {v} vs {potential}"
+        );
+    }
+}
+
+#[test]
+fn states_agree_with_the_task_evaluator_along_a_quintic_move() {
+    // Task 0→8 of the imported arm: u from (-1.5, -2.5) to (1.5, 2.5) in 2 s, rest to rest,
+    // u(t) = u0 + Δ·(10s³ − 15s⁴ + 6s⁵), s = t/T. The task evaluator's actuator forces at its
+    // samples must equal the states evaluation at the same (q, q̇, q̈).
+    let dir = tempfile::tempdir().unwrap();
+    let series_path = dir.path().join("series.json");
+    let out = counterpoise(&[
+        "evaluate",
+        "cases/two_link_urdf.json",
+        "--task",
+        "0,8",
+        "--series",
+        series_path.to_str().unwrap(),
+    ]);
+    assert_success(&out);
+    let series: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&series_path).unwrap()).unwrap();
+    let (u0, delta, duration) = ([-1.5, -2.5], [3.0, 5.0], 2.0);
+    let picks = [3usize, 8, 15];
+    let states: Vec<serde_json::Value> = picks
+        .iter()
+        .map(|&k| {
+            let t = series["t"][k].as_f64().unwrap();
+            let s = t / duration;
+            let p = 10.0 * s.powi(3) - 15.0 * s.powi(4) + 6.0 * s.powi(5);
+            let dp = (30.0 * s.powi(2) - 60.0 * s.powi(3) + 30.0 * s.powi(4)) / duration;
+            let ddp = (60.0 * s - 180.0 * s.powi(2) + 120.0 * s.powi(3)) / (duration * duration);
+            serde_json::json!({
+                "q": [u0[0] + delta[0] * p, u0[1] + delta[1] * p],
+                "qd": [delta[0] * dp, delta[1] * dp],
+                "qdd": [delta[0] * ddp, delta[1] * ddp],
+            })
+        })
+        .collect();
+    let doc = states_of("cases/two_link_urdf.json", &serde_json::json!(states));
+    for (n, &k) in picks.iter().enumerate() {
+        for a in 0..2 {
+            let want = series["actuator_force"][k][a].as_f64().unwrap();
+            let got = doc["states"][n]["actuator_forces"][a].as_f64().unwrap();
+            assert!(
+                (got - want).abs() < 1e-9 * (1.0 + want.abs()),
+                "sample {k}: {got} vs {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn states_of_the_wrong_size_are_refused_naming_the_state() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("states.json");
+    std::fs::write(&path, r#"[{"q": [0, 0]}, {"q": [0, 0], "qd": [1]}]"#).unwrap();
+    let out = counterpoise(&[
+        "evaluate",
+        "cases/two_link_urdf.json",
+        "--states",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("states[1].qd: 1 values for 2 coordinates"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -4,6 +4,7 @@ pub mod check;
 pub mod evaluate;
 pub mod import_urdf;
 pub mod run;
+pub mod states;
 pub mod variants;
 
 use std::path::Path;
