@@ -140,25 +140,38 @@ fn states_give_the_closed_form_inverse_dynamics_of_the_two_link_arm() {
     }
 }
 
-#[test]
-fn states_agree_with_the_task_evaluator_along_a_quintic_move() {
-    // Task 0→8 of the imported arm: u from (-1.5, -2.5) to (1.5, 2.5) in 2 s, rest to rest,
-    // u(t) = u0 + Δ·(10s³ − 15s⁴ + 6s⁵), s = t/T. The task evaluator's actuator forces at its
-    // samples must equal the states evaluation at the same (q, q̇, q̈).
+/// Checks `--states` against the task evaluator along the task from the first to the last grid
+/// point of `case` (every actuator `u = q`, ratio 1): a rest-to-rest quintic
+/// `u(t) = u0 + Δ·(10s³ − 15s⁴ + 6s⁵)`, `s = t/T`. The evaluator's actuator forces at its
+/// samples must equal the states evaluation at the same `(q, q̇, q̈)`.
+fn states_match_the_task_evaluator(case: &str) {
     let dir = tempfile::tempdir().unwrap();
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(case).unwrap()).unwrap();
+    let axes: Vec<[f64; 3]> = doc["actuators"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| {
+            let axis = &doc["tasks"]["grid"][a["name"].as_str().unwrap()];
+            [0, 1, 2].map(|i| axis[i].as_f64().unwrap())
+        })
+        .collect();
+    let last: usize = axes.iter().map(|a| a[2] as usize).product::<usize>() - 1;
+    let duration = doc["tasks"]["duration"].as_f64().unwrap();
     let series_path = dir.path().join("series.json");
+    let task = format!("0,{last}");
     let out = counterpoise(&[
         "evaluate",
-        "cases/two_link_urdf.json",
+        case,
         "--task",
-        "0,8",
+        &task,
         "--series",
         series_path.to_str().unwrap(),
     ]);
     assert_success(&out);
     let series: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&series_path).unwrap()).unwrap();
-    let (u0, delta, duration) = ([-1.5, -2.5], [3.0, 5.0], 2.0);
     let picks = [3usize, 8, 15];
     let states: Vec<serde_json::Value> = picks
         .iter()
@@ -168,24 +181,40 @@ fn states_agree_with_the_task_evaluator_along_a_quintic_move() {
             let p = 10.0 * s.powi(3) - 15.0 * s.powi(4) + 6.0 * s.powi(5);
             let dp = (30.0 * s.powi(2) - 60.0 * s.powi(3) + 30.0 * s.powi(4)) / duration;
             let ddp = (60.0 * s - 180.0 * s.powi(2) + 120.0 * s.powi(3)) / (duration * duration);
+            let d = |a: &[f64; 3]| a[1] - a[0];
             serde_json::json!({
-                "q": [u0[0] + delta[0] * p, u0[1] + delta[1] * p],
-                "qd": [delta[0] * dp, delta[1] * dp],
-                "qdd": [delta[0] * ddp, delta[1] * ddp],
+                "q": axes.iter().map(|a| a[0] + d(a) * p).collect::<Vec<_>>(),
+                "qd": axes.iter().map(|a| d(a) * dp).collect::<Vec<_>>(),
+                "qdd": axes.iter().map(|a| d(a) * ddp).collect::<Vec<_>>(),
             })
         })
         .collect();
-    let doc = states_of("cases/two_link_urdf.json", &serde_json::json!(states));
+    let doc = states_of(case, &serde_json::json!(states));
     for (n, &k) in picks.iter().enumerate() {
-        for a in 0..2 {
+        for a in 0..axes.len() {
             let want = series["actuator_force"][k][a].as_f64().unwrap();
             let got = doc["states"][n]["actuator_forces"][a].as_f64().unwrap();
             assert!(
                 (got - want).abs() < 1e-9 * (1.0 + want.abs()),
-                "sample {k}: {got} vs {want}"
+                "{case} sample {k} actuator {a}: {got} vs {want}"
             );
         }
     }
+}
+
+#[test]
+fn states_agree_with_the_task_evaluator_on_the_planar_and_the_seven_joint_arm() {
+    states_match_the_task_evaluator("cases/two_link_urdf.json");
+    let dir = tempfile::tempdir().unwrap();
+    let seven = dir.path().join("seven.json");
+    let out = counterpoise(&[
+        "import-urdf",
+        "crates/urdf/tests/data/seven_dof.urdf",
+        "--out",
+        seven.to_str().unwrap(),
+    ]);
+    assert_success(&out);
+    states_match_the_task_evaluator(seven.to_str().unwrap());
 }
 
 #[test]
