@@ -7,7 +7,7 @@
 //! the axis components for the rotation that carries z onto a joint axis), and the balance
 //! search then decides the case numerically.
 
-use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Rotation3, Vector3};
 use serde_json::{Value, json};
 
 use crate::parse::Origin;
@@ -301,22 +301,19 @@ pub fn prismatic_steps(axis: [f64; 3], length: &LengthExpr) -> Vec<Value> {
     vec![json!({ "translate": parts })]
 }
 
-/// A joint frozen at a constant value, numerically: rotation about or slide along the axis.
+/// A joint frozen at a constant value, numerically only (the links beyond a frozen joint are
+/// merged into a body, never posed by steps): rotation about or slide along the unit axis.
 pub fn frozen_motion(axis: [f64; 3], angular: bool, value: f64) -> Placement {
     let u = unit_axis(axis);
-    if angular {
-        let r = UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_unchecked(u), value);
-        Placement {
-            steps: Vec::new(),
-            rotation: *Rotation3::from(r).matrix(),
-            translation: Vector3::zeros(),
-        }
+    let (rotation, translation) = if angular {
+        let r = Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(u), value);
+        (*r.matrix(), Vector3::zeros())
     } else {
-        let iso = Isometry3::from_parts(Translation3::from(u * value), UnitQuaternion::identity());
-        Placement {
-            steps: Vec::new(),
-            rotation: Matrix3::identity(),
-            translation: iso.translation.vector,
-        }
+        (Matrix3::identity(), u * value)
+    };
+    Placement {
+        steps: Vec::new(),
+        rotation,
+        translation,
     }
 }

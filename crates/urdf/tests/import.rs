@@ -267,6 +267,30 @@ fn tip_freezes_the_joints_beyond_it_and_base_cuts_the_links_above() {
     assert_eq!(model.coordinates.len(), 2);
     // l3 and the tool are frozen at j3 = 0 and carried by l2: 2 + 1.5 + 0.5 kg.
     assert_eq!(model.bodies[1].mass, 4.0);
+    for q in configurations(&model, 10) {
+        let value = |joint: &str| match joint {
+            "j1" => q[0],
+            "j2" => q[1],
+            _ => 0.0,
+        };
+        let expected = urdf_potential(&data("three_dof.urdf"), &value);
+        assert!((potential(&model, &q) - expected).abs() < 1e-11, "{q:?}");
+    }
+    // Frozen at a value clamped into the limits: j3 ∈ [0.5, 2.5] freezes at 0.5.
+    let shifted = data("three_dof.urdf").replace(
+        "<limit lower=\"-2.5\" upper=\"2.5\" effort=\"30\"",
+        "<limit lower=\"0.5\" upper=\"2.5\" effort=\"30\"",
+    );
+    let model = import(&shifted, &options_tip()).unwrap().model;
+    for q in configurations(&model, 10) {
+        let value = |joint: &str| match joint {
+            "j1" => q[0],
+            "j2" => q[1],
+            _ => 0.5,
+        };
+        let expected = urdf_potential(&shifted, &value);
+        assert!((potential(&model, &q) - expected).abs() < 1e-11, "{q:?}");
+    }
     let options = ImportOptions {
         base: Some("l1".into()),
         tip: None,
@@ -274,6 +298,13 @@ fn tip_freezes_the_joints_beyond_it_and_base_cuts_the_links_above() {
     let model = import(&data("three_dof.urdf"), &options).unwrap().model;
     let names: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
     assert_eq!(names, ["l2", "l3"]);
+}
+
+fn options_tip() -> ImportOptions {
+    ImportOptions {
+        base: None,
+        tip: Some("l2".into()),
+    }
 }
 
 fn error_of(urdf: &str) -> String {
