@@ -61,6 +61,10 @@ enum Command {
         /// File for the time series of --task (JSON).
         #[arg(long, requires = "task")]
         series: Option<PathBuf>,
+        /// Inverse dynamics at the states of FILE (a JSON array of {"q", "qd", "qdd"}):
+        /// actuator forces, motor torques and potential energy, as JSON.
+        #[arg(long, value_name = "FILE", conflicts_with_all = ["task", "series", "samples", "no_reactions"])]
+        states: Option<PathBuf>,
     },
     /// The whole case study: unbalanced indicators, balance search, optimisation, ranking,
     /// reports (results.json, report.html, report.md, ranking.csv).
@@ -79,6 +83,21 @@ enum Command {
         /// Ranking resolution in percentage points: closer values tie.
         #[arg(long, default_value_t = 0.01)]
         resolution: f64,
+    },
+    /// Write a case file from a URDF robot description (bodies, joints, actuators, a default
+    /// balancing section and task grid).
+    ImportUrdf {
+        /// The robot description (URDF).
+        urdf: PathBuf,
+        /// Case file to write (default: standard output).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Link fixed to the ground (default: the URDF's root link).
+        #[arg(long)]
+        base: Option<String>,
+        /// Last link of the chain: joints off the base-tip path are frozen at 0.
+        #[arg(long)]
+        tip: Option<String>,
     },
     /// Regenerate report.html, report.md and ranking.csv from DIR/results.json.
     Report {
@@ -145,11 +164,17 @@ fn run(cli: Cli) -> ExitCode {
         Command::Variants { case, dmax, json } => commands::variants::run(&case, dmax, json),
         Command::Evaluate {
             case,
+            states: Some(states),
+            ..
+        } => commands::states::run(&case, &states),
+        Command::Evaluate {
+            case,
             json,
             samples,
             no_reactions,
             task,
             series,
+            states: None,
         } => commands::evaluate::run(
             &case,
             commands::evaluate::Options {
@@ -176,6 +201,16 @@ fn run(cli: Cli) -> ExitCode {
             },
         ),
         Command::Report { dir } => commands::report(&dir),
+        Command::ImportUrdf {
+            urdf,
+            out,
+            base,
+            tip,
+        } => commands::import_urdf::run(
+            &urdf,
+            out.as_deref(),
+            counterpoise_urdf::ImportOptions { base, tip },
+        ),
     };
     match result {
         Ok(code) => code,

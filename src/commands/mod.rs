@@ -2,7 +2,9 @@
 
 pub mod check;
 pub mod evaluate;
+pub mod import_urdf;
 pub mod run;
+pub mod states;
 pub mod variants;
 
 use std::path::Path;
