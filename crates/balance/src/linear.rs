@@ -222,6 +222,9 @@ fn column_norms(matrix: &DMatrix<f64>) -> DVector<f64> {
     )
 }
 
+/// A singular value with its left and right singular vectors.
+type Triplet = (f64, DVector<f64>, DVector<f64>);
+
 /// One SVD's reading of a variant: its least-scaled-norm solution, free directions and rank.
 struct SvdFamily {
     particular: DVector<f64>,
@@ -235,7 +238,7 @@ fn family_from_svd(
     matrix: &DMatrix<f64>,
     b: &DVector<f64>,
     column_scale: &DVector<f64>,
-    triplets: &[(f64, DVector<f64>, DVector<f64>)],
+    triplets: &[Triplet],
 ) -> SvdFamily {
     let cols = matrix.ncols();
     let sigma_max = triplets.iter().fold(0.0f64, |a, t| a.max(t.0));
@@ -280,7 +283,7 @@ fn family_from_svd(
 fn faer_triplets(
     matrix: &DMatrix<f64>,
     column_scale: &DVector<f64>,
-) -> Result<Vec<(f64, DVector<f64>, DVector<f64>)>, String> {
+) -> Result<Vec<Triplet>, String> {
     let (rows, cols) = matrix.shape();
     let scaled = faer::Mat::from_fn(rows, cols, |i, j| matrix[(i, j)] / column_scale[j]);
     let svd = scaled
@@ -298,10 +301,7 @@ fn faer_triplets(
 }
 
 /// The same triplets by nalgebra (padded so that the thin SVD yields every right vector).
-fn nalgebra_triplets(
-    matrix: &DMatrix<f64>,
-    column_scale: &DVector<f64>,
-) -> Vec<(f64, DVector<f64>, DVector<f64>)> {
+fn nalgebra_triplets(matrix: &DMatrix<f64>, column_scale: &DVector<f64>) -> Vec<Triplet> {
     let (rows, cols) = matrix.shape();
     let mut scaled = DMatrix::zeros(rows.max(cols), cols);
     for j in 0..cols {

@@ -55,7 +55,8 @@ pub enum VariantStatus {
     Discarded,
     /// Balanced in lifted parameters, but no physical parameters exist.
     Unrealizable,
-    /// Balance forces an element to vanish: really a smaller variant.
+    /// Realizable, but some element can only idle (it contributes no energy in any balancing
+    /// solution): really a smaller variant plus idle parts, not optimised.
     Degenerate,
     /// The search or the optimiser could not decide.
     Undecided,
@@ -94,7 +95,9 @@ impl VariantStatus {
             VariantStatus::Unrealizable => {
                 "balanced in lifted parameters, no physical parameters exist"
             }
-            VariantStatus::Degenerate => "balance forces an element to vanish (a smaller variant)",
+            VariantStatus::Degenerate => {
+                "realizable, but an element can only idle (a smaller variant)"
+            }
             VariantStatus::Undecided => "the search or optimiser could not decide",
             VariantStatus::Infeasible => "no parameters balance the mechanism",
         }
