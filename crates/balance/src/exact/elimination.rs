@@ -299,6 +299,10 @@ mod tests {
         }
         // x = 6/5·… : 2x + 4y = 6, −3x + 9y = 0 ⇒ x = 3y, 10y = 6 ⇒ y = 3/5, x = 9/5.
         assert_eq!(small.particular(), vec![q(9, 5), q(3, 5)]);
+        // A negative pivot is made positive: −2x + 4y = 6 becomes x − 2y = −3.
+        let flipped = eliminate_small(&big(&[&[-2, 4, 6]]), 2).expect("small");
+        assert_eq!(flipped.rows, big(&[&[1, -2, -3]]));
+        assert_eq!(flipped.particular(), vec![q(-3, 1), q(0, 1)]);
         // Entries beyond i128 leave the small path.
         let huge = BigInt::from(2).pow(130);
         assert!(eliminate_small(&[vec![huge.clone(), huge]], 1).is_none());
