@@ -146,13 +146,13 @@ fn excluded_from(failures: &[TaskFailure]) -> Excluded {
     }
 }
 
-/// Runs every grid task for every column of `params` (in parallel over tasks on the current
-/// rayon pool; results are identical for any thread count).
-pub fn evaluate_grid(
-    model: &Model,
+/// What both grid evaluations start from: the task set, the evaluator, and the cyclic coordinate
+/// when the shortcut applies (it needs every spring between two bodies).
+fn grid_setup<'m>(
+    model: &'m Model,
     params: &ParameterSet,
     options: &EvaluateOptions,
-) -> Result<GridEvaluation, DynamicsError> {
+) -> Result<(TaskSet, Evaluator<'m>, Option<crate::symmetry::Cyclic>), DynamicsError> {
     let tasks = TaskSet::new(
         model.tasks.as_ref().ok_or(DynamicsError::NoTasks)?,
         options.samples,
@@ -163,6 +163,17 @@ pub fn evaluate_grid(
     } else {
         None
     };
+    Ok((tasks, ev, cyclic))
+}
+
+/// Runs every grid task for every column of `params` (in parallel over tasks on the current
+/// rayon pool; results are identical for any thread count).
+pub fn evaluate_grid(
+    model: &Model,
+    params: &ParameterSet,
+    options: &EvaluateOptions,
+) -> Result<GridEvaluation, DynamicsError> {
+    let (tasks, ev, cyclic) = grid_setup(model, params, options)?;
     let joints = if options.reactions {
         ev.reactions.joint_count()
     } else {
@@ -230,16 +241,7 @@ pub fn evaluate_grid_indicators(
     params: &ParameterSet,
     options: &EvaluateOptions,
 ) -> Result<GridIndicators, DynamicsError> {
-    let tasks = TaskSet::new(
-        model.tasks.as_ref().ok_or(DynamicsError::NoTasks)?,
-        options.samples,
-    )?;
-    let ev = Evaluator::new(model)?;
-    let cyclic = if options.shortcut && params.springs.iter().all(|s| s.other.is_some()) {
-        crate::symmetry::detect_cyclic(model, &ev.mech)
-    } else {
-        None
-    };
+    let (tasks, ev, cyclic) = grid_setup(model, params, options)?;
     let Some(cyc) = cyclic else {
         let grid = evaluate_grid(model, params, options)?;
         return Ok(GridIndicators {
