@@ -3,23 +3,12 @@
 
 mod common;
 
-use common::{case, case_from_text};
+use common::{case_from_text, coarse_palletizer};
 use counterpoise_dynamics::{
     Counterweight, EvaluateOptions, ParameterSet, Spring, Variant, evaluate, evaluate_grid,
     task_series,
 };
 use counterpoise_model::{GridAxis, Model};
-
-/// The palletizer on a coarse 3×3×3 grid (351 tasks) with 11 samples per task.
-fn coarse_palletizer() -> Model {
-    let mut model = case("palletizer");
-    let tasks = model.tasks.as_mut().unwrap();
-    for axis in &mut tasks.grid {
-        axis.n = 3;
-    }
-    tasks.samples = 11;
-    model
-}
 
 #[test]
 fn unreachable_tasks_are_excluded_not_fatal() {

@@ -3,24 +3,11 @@
 
 mod common;
 
-use common::case;
+use common::coarse_palletizer;
 use counterpoise_dynamics::{
     Counterweight, EvaluateOptions, ParameterSet, Spring, Variant, evaluate_grid,
     evaluate_grid_indicators,
 };
-use counterpoise_model::Model;
-
-/// The palletizer on a coarse 3×3×3 grid with 11 samples per task (θ1 is cyclic, so the
-/// cyclic decomposition runs).
-fn coarse_palletizer() -> Model {
-    let mut model = case("palletizer");
-    let tasks = model.tasks.as_mut().unwrap();
-    for axis in &mut tasks.grid {
-        axis.n = 3;
-    }
-    tasks.samples = 11;
-    model
-}
 
 fn variants() -> Vec<Variant> {
     vec![

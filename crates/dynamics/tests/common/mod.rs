@@ -30,3 +30,15 @@ pub fn assert_close(a: f64, b: f64, tol: f64, what: &str) {
         (a - b).abs()
     );
 }
+
+/// The palletizer on a coarse 3×3×3 grid (351 tasks) with 11 samples per task (θ1 is cyclic,
+/// so the cyclic decomposition runs).
+pub fn coarse_palletizer() -> Model {
+    let mut model = case("palletizer");
+    let tasks = model.tasks.as_mut().unwrap();
+    for axis in &mut tasks.grid {
+        axis.n = 3;
+    }
+    tasks.samples = 11;
+    model
+}
