@@ -10,8 +10,6 @@
 //! Defaults: Dmax = 3, 3 runs. Prints each run's phases, then per phase the median and the range
 //! over the runs, and the verdict counts of the last run.
 
-use std::time::Instant;
-
 use counterpoise_balance::{
     Catalogue, SearchOptions, Status, catalogue_options, mechanism_energy, realization_hints,
     search,
@@ -19,7 +17,7 @@ use counterpoise_balance::{
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{EvaluateOptions, evaluate_grid};
 use counterpoise_model::Case;
-use counterpoise_optimise::{Context, OptimiseOptions, optimise_all_timed};
+use counterpoise_optimise::{Context, OptimiseOptions, StageTime, Stopwatch, optimise_all_timed};
 
 fn median_range(mut v: Vec<f64>) -> String {
     v.sort_by(f64::total_cmp);
@@ -29,6 +27,10 @@ fn median_range(mut v: Vec<f64>) -> String {
         v[0],
         v[v.len() - 1]
     )
+}
+
+fn column(stages: &[StageTime], pick: impl Fn(&StageTime) -> f64) -> String {
+    median_range(stages.iter().map(pick).collect())
 }
 
 fn main() {
@@ -48,19 +50,19 @@ fn main() {
         "optimisation: records",
         "total",
     ];
-    let mut table: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+    let mut table: Vec<Vec<StageTime>> = vec![Vec::new(); names.len()];
     let mut last = Vec::new();
     for run in 0..runs {
-        let start = Instant::now();
-        let t = Instant::now();
+        let start = Stopwatch::start();
+        let t = Stopwatch::start();
         let mut ub = evaluate_grid(
             &model,
             &ParameterSet::unbalanced(&model),
             &EvaluateOptions::default(),
         )
         .expect("phase 1");
-        let phase1 = t.elapsed().as_secs_f64();
-        let t = Instant::now();
+        let phase1 = t.elapsed();
+        let t = Stopwatch::start();
         let energy = mechanism_energy(&model);
         let report = search(
             &energy,
@@ -70,12 +72,12 @@ fn main() {
                 hints: realization_hints(&model),
             },
         );
-        let searched = t.elapsed().as_secs_f64();
-        let t = Instant::now();
+        let searched = t.elapsed();
+        let t = Stopwatch::start();
         let ctx = Context::new(&model, Some(ub.indicators.swap_remove(0))).expect("context");
-        let context = t.elapsed().as_secs_f64();
+        let context = t.elapsed();
         let (out, stages) = optimise_all_timed(&ctx, &report.variants, &OptimiseOptions::default());
-        let total = start.elapsed().as_secs_f64();
+        let total = start.elapsed();
         let row = [
             phase1,
             searched,
@@ -92,7 +94,7 @@ fn main() {
             names
                 .iter()
                 .zip(row)
-                .map(|(n, s)| format!("{n} {s:.2} s"))
+                .map(|(n, s)| format!("{n} {:.2} s ({:.2} s CPU)", s.wall, s.cpu))
                 .collect::<Vec<_>>()
                 .join(", "),
             stages.passes
@@ -107,9 +109,15 @@ fn main() {
             .count();
         last = vec![(balanced, out)];
     }
-    println!("palletizer, Dmax = {dmax}, {runs} runs (median [min–max]):");
+    println!(
+        "palletizer, Dmax = {dmax}, {runs} runs (median [min–max]), wall and CPU (all threads):"
+    );
     for (n, col) in names.iter().zip(table) {
-        println!("  {n:<30} {}", median_range(col));
+        println!(
+            "  {n:<30} {}   CPU {}",
+            column(&col, |t| t.wall),
+            column(&col, |t| t.cpu)
+        );
     }
     if let Some((balanced, out)) = last.pop() {
         let feasible = out.iter().filter(|v| v.is_feasible()).count();

@@ -34,6 +34,7 @@ use crate::result::{
     OptimisedVariant,
 };
 use crate::springs::{SpringValues, realize_springs};
+use crate::timing::{StageTime, Stopwatch};
 use crate::verify::verify;
 
 /// Settings of the optimisation.
@@ -141,24 +142,24 @@ pub fn optimise_all(
     optimise_all_timed(ctx, variants, options).0
 }
 
-/// Wall time of the stages of [`optimise_all`], seconds.
+/// Wall and CPU time of the stages of [`optimise_all`].
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct StageTimings {
     /// Relaxations, refinements and spring realizations of every pass.
-    pub solve: f64,
+    pub solve: StageTime,
     /// The all-task torque evaluations of the critical-task loop.
-    pub loop_grid: f64,
+    pub loop_grid: StageTime,
     /// Spring choice by ΔR on the reaction tasks.
-    pub spring_choice: f64,
+    pub spring_choice: StageTime,
     /// Final all-task evaluation (torques and joint reactions).
-    pub final_grid: f64,
+    pub final_grid: StageTime,
     /// Verification and records.
-    pub records: f64,
+    pub records: StageTime,
     /// Passes of the critical-task loop.
     pub passes: usize,
 }
 
-/// [`optimise_all`] with the wall time of each stage.
+/// [`optimise_all`] with the wall and CPU time of each stage.
 pub fn optimise_all_timed(
     ctx: &Context,
     variants: &[VariantResult],
@@ -185,7 +186,7 @@ pub fn optimise_all_timed(
             .into_iter()
             .collect();
         timings.passes += 1;
-        let started = std::time::Instant::now();
+        let started = Stopwatch::start();
         let (_, failures) = ctx.torques.get(&ctx.model, &ctx.tasks, &union);
         let failed: BTreeSet<usize> = failures.iter().map(|f| f.0).collect();
 
@@ -193,8 +194,8 @@ pub fn optimise_all_timed(
             .par_iter()
             .map(|&k| (k, step(ctx, &runs[k], &failed, options)))
             .collect();
-        timings.solve += started.elapsed().as_secs_f64();
-        let started = std::time::Instant::now();
+        timings.solve += started.elapsed();
+        let started = Stopwatch::start();
         let mut evaluated: Vec<usize> = Vec::new();
         for (k, outcome) in outcomes {
             match outcome {
@@ -210,7 +211,7 @@ pub fn optimise_all_timed(
         }
         let dyn_variants = candidate_variants(&runs, &evaluated);
         let indicators = grid_indicators(ctx, &dyn_variants, false);
-        timings.loop_grid += started.elapsed().as_secs_f64();
+        timings.loop_grid += started.elapsed();
         let indicators = match indicators {
             Ok(i) => i,
             Err(e) => {
@@ -783,7 +784,7 @@ fn finish(
     options: &OptimiseOptions,
     timings: &mut StageTimings,
 ) -> Vec<OptimisedVariant> {
-    let started = std::time::Instant::now();
+    let started = Stopwatch::start();
     // Reaction tasks: the critical tasks plus the unbalanced joints' critical tasks.
     let mut joint_tasks = BTreeSet::new();
     for j in &ctx.unbalanced.joints {
@@ -850,8 +851,8 @@ fn finish(
             c.x = x.clone();
         }
     }
-    timings.spring_choice = started.elapsed().as_secs_f64();
-    let started = std::time::Instant::now();
+    timings.spring_choice = started.elapsed();
+    let started = Stopwatch::start();
     // Final evaluation over all tasks, batched.
     let finals: Vec<usize> = (0..runs.len())
         .filter(|&k| {
@@ -873,15 +874,15 @@ fn finish(
         });
     }
 
-    timings.final_grid = started.elapsed().as_secs_f64();
-    let started = std::time::Instant::now();
+    timings.final_grid = started.elapsed();
+    let started = Stopwatch::start();
     let out = runs
         .into_iter()
         .zip(choices)
         .zip(indicators_of)
         .map(|((run, choice), ind)| record(ctx, run, choice.and_then(|c| c.2), ind, options))
         .collect();
-    timings.records = started.elapsed().as_secs_f64();
+    timings.records = started.elapsed();
     out
 }
 

@@ -32,6 +32,7 @@ pub mod refine;
 pub mod relaxation;
 pub mod result;
 pub mod springs;
+pub mod timing;
 pub mod torque;
 pub mod verify;
 
@@ -48,4 +49,5 @@ pub use result::{
     DisplayRow, FreeParameter, Iteration, OptimisedCounterweight, OptimisedSpring, OptimisedStatus,
     OptimisedVariant, display_rows,
 };
+pub use timing::{StageTime, Stopwatch, process_cpu_seconds};
 pub use verify::{PeakCheck, VerificationReport};
