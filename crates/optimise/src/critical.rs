@@ -736,13 +736,14 @@ fn free_parameters(
     components: &[Vec<(String, f64)>],
     x: &DVector<f64>,
 ) -> Vec<FreeParameter> {
-    let n = &problem.nullspace;
+    // The balance search's free directions (the search itself may run on a restricted family).
+    let n = &problem.solution.nullspace;
     let d = n.ncols();
     if d == 0 {
         return Vec::new();
     }
     // Coordinates of x in the family: least squares on N (exact: x is in the family).
-    let delta = x - &problem.particular;
+    let delta = x - &problem.solution.particular;
     let z = n
         .clone()
         .svd(true, true)

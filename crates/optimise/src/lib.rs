@@ -21,6 +21,7 @@
 // Index loops over samples, actuators and axes read like the formulas they implement.
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
+pub mod anchor_restriction;
 pub mod clarabel_map;
 pub mod context;
 pub mod critical;

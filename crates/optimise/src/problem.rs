@@ -86,6 +86,8 @@ pub struct VariantProblem {
     pub labels: Vec<String>,
     pub counterweights: Vec<CwSlot>,
     pub springs: Vec<SpringSlot>,
+    /// The family searched, `x = x_p + N z`: the balance search's family restricted by the
+    /// anchors it fixes ([`crate::anchor_restriction`]); `solution` keeps the unrestricted one.
     pub particular: DVector<f64>,
     pub nullspace: DMatrix<f64>,
     pub solution: LinearSolution,
@@ -201,6 +203,13 @@ impl VariantProblem {
             .unwrap_or_default();
         let mut peak_limits = peak_limits;
         peak_limits.resize(model.actuators.len(), None);
+        // Search the family restricted by the anchors balance fixes (see `anchor_restriction`).
+        let (particular, nullspace) = crate::anchor_restriction::restrict(
+            &springs,
+            &solution.particular,
+            &solution.nullspace,
+        )
+        .unwrap_or_else(|| (solution.particular.clone(), solution.nullspace.clone()));
         Ok(VariantProblem {
             set: set.to_vec(),
             labels: set
@@ -209,8 +218,8 @@ impl VariantProblem {
                 .collect(),
             counterweights,
             springs,
-            particular: solution.particular.clone(),
-            nullspace: solution.nullspace.clone(),
+            particular,
+            nullspace,
             solution,
             peak_limits,
             actuators: model.actuators.len(),

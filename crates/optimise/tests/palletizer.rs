@@ -151,3 +151,72 @@ fn the_papers_eleven_sets() {
         );
     }
 }
+
+/// `m4 + K42` balances only with K42's anchor a at x = 1/4 on the upper arm and b on the
+/// slider's y axis (relations `K42 − 4·K42·ax = 0`, `K42·ay = 0`, `K42·bx = 0`), so a physical
+/// spring has `K·ax·by = K·by/4` and `K·ax·bx = K·ay·by = 0`. The lifted family alone leaves
+/// those products free; optimising there ended at counterweights no spring could complete (and
+/// the variant was lost). Checked against the exact relations printed by the balance search,
+/// solved by hand for the physical parameters:
+/// `m4 − (100/981)·K·by = 1829/8` and `m4·r4x − (100/981)·K·ax·by = −1851/8`, with `ax = 1/4`
+/// and `r4y = 0`, on the full task grid's peak limits.
+#[test]
+fn a_spring_whose_anchor_balance_fixes_is_realized_on_the_restricted_family() {
+    let json = common::case_json("palletizer.json");
+    let model = common::model(&json);
+    let (ctx, results) = common::optimise(&model, &[&["m4", "K42"]], &OptimiseOptions::default());
+    // The physical family is two-dimensional (K and K·by fix everything else), the lifted one
+    // six-dimensional; the search runs on the restricted one.
+    let set: Vec<usize> = ["m4", "K42"]
+        .iter()
+        .map(|l| {
+            ctx.catalogue
+                .entries
+                .iter()
+                .position(|e| &e.label == l)
+                .unwrap()
+        })
+        .collect();
+    let problem = counterpoise_optimise::problem::VariantProblem::new(
+        &ctx.model,
+        &ctx.catalogue,
+        &ctx.bounds,
+        &set,
+        counterpoise_balance::linear::solve(&ctx.basis, &set),
+        |b| ctx.torques.slot_of(b),
+    )
+    .unwrap();
+    assert_eq!(problem.solution.nullspace.ncols(), 6);
+    assert_eq!(problem.dim(), 2);
+    let v = &results[0];
+    assert!(v.is_feasible(), "{:?}", v.reason);
+    let c = &v.counterweights[0];
+    let k = &v.springs[0];
+    let (m, rx, ry) = (c.mass, c.offset[0], c.offset[1]);
+    let (kk, ax, ay, bx, by) = (
+        k.stiffness,
+        k.anchor_a[0],
+        k.anchor_a[1],
+        k.anchor_b[0],
+        k.anchor_b[1],
+    );
+    assert!((ax - 0.25).abs() < 1e-9 && ay.abs() < 1e-9 && bx.abs() < 1e-9);
+    assert!(ry.abs() < 1e-9, "r4y = {ry}");
+    let g = 100.0 / 981.0;
+    assert!(
+        (m - g * kk * by - 1829.0 / 8.0).abs() < 1e-6 * m,
+        "mass relation"
+    );
+    assert!(
+        (m * rx - g * kk * ax * by + 1851.0 / 8.0).abs() < 1e-6 * m,
+        "first-moment relation"
+    );
+    let limits = json["balancing"]["peak_limits"].as_object().unwrap();
+    for a in &v.indicators.as_ref().unwrap().actuators {
+        assert!(
+            a.cpt_peak <= limits[&a.name].as_f64().unwrap(),
+            "{}",
+            a.name
+        );
+    }
+}
