@@ -28,7 +28,7 @@
 use std::sync::Arc;
 
 use counterpoise_dynamics::params::BODY_PARAMS;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 use crate::clarabel_map::{Affine, ConicProblem, ConicSolution};
 use crate::problem::{Objective, VariantProblem};
@@ -104,6 +104,53 @@ fn natural_scales(problem: &VariantProblem) -> Vec<f64> {
     scale
 }
 
+/// A lifted quantity the torque is linear in (a counterweight's `m`, `μ_a`, `S_ab` or `p`),
+/// as an affine expression of the conic variables, with its torque columns.
+struct Feature {
+    expr: Affine,
+    /// (slot, π index, coefficient) — torque per unit feature = Σ coef·sens(slot, idx).
+    parts: Vec<(usize, usize, f64)>,
+}
+
+/// The tail of actuator `a`'s RMS cone on one task: expressions whose Euclidean norm is
+/// `w·‖τ_a‖` over the task's samples.
+///
+/// The sampled torque is `τ_a = T e` with `e = (1, f_1, …, f_F)` the features and `T` the
+/// `samples × (1 + F)` matrix of the base torque and the feature columns. For the QR
+/// factorisation `T = Q R`, `‖T e‖ = ‖R e‖` for every `e`, so the `1 + F` rows of `R e` stand
+/// for the 51 sample rows exactly: the same cone, the same optimum, a much smaller problem for
+/// the solver (an orthogonal transformation, backward stable).
+fn rms_tail(task: &TaskTorques, a: usize, w: f64, features: &[Feature]) -> Vec<Affine> {
+    let na = task.actuators;
+    let n = task.samples;
+    let width = 1 + features.len();
+    let mut t = DMatrix::<f64>::zeros(n, width);
+    for s in 0..n {
+        t[(s, 0)] = w * task.base[s * na + a];
+        for (k, f) in features.iter().enumerate() {
+            let coef: f64 = f
+                .parts
+                .iter()
+                .map(|&(slot, j, c)| c * task.sens(slot, j)[s * na + a])
+                .sum();
+            t[(s, 1 + k)] = w * coef;
+        }
+    }
+    let rows = if n > width { t.qr().r() } else { t };
+    (0..rows.nrows())
+        .map(|i| {
+            let mut e = Affine::constant(rows[(i, 0)]);
+            for (k, f) in features.iter().enumerate() {
+                let c = rows[(i, 1 + k)];
+                if c != 0.0 {
+                    e.add_scaled(&f.expr, c);
+                }
+            }
+            e
+        })
+        .collect()
+}
+
 /// Builds and solves the relaxation on the working-set tasks.
 pub fn solve_relaxation(
     problem: &VariantProblem,
@@ -138,11 +185,6 @@ pub fn solve_relaxation(
     };
 
     // Per counterweight: feature expressions (true units) and their torque columns.
-    struct Feature {
-        expr: Affine,
-        /// (slot, π index, coefficient) — torque per unit feature = Σ coef·sens(slot, idx).
-        parts: Vec<(usize, usize, f64)>,
-    }
     let mut features: Vec<Feature> = Vec::new();
     for c in &problem.counterweights {
         let big_m = natural[c.column];
@@ -357,10 +399,7 @@ pub fn solve_relaxation(
             for task in tasks {
                 let w = 1.0 / ((task.samples as f64).sqrt() * tau_scale);
                 for a in 0..na {
-                    let tail: Vec<Affine> = (0..task.samples)
-                        .map(|s| torque(task, s, a).scaled(w))
-                        .collect();
-                    cp.soc(&Affine::var(t[a]), &tail);
+                    cp.soc(&Affine::var(t[a]), &rms_tail(task, a, w, &features));
                 }
             }
         }
@@ -371,10 +410,7 @@ pub fn solve_relaxation(
                 let mut sum = Affine::var(u);
                 for a in 0..na {
                     sum.add_var(t[a], -1.0);
-                    let tail: Vec<Affine> = (0..task.samples)
-                        .map(|s| torque(task, s, a).scaled(w))
-                        .collect();
-                    cp.soc(&Affine::var(t[a]), &tail);
+                    cp.soc(&Affine::var(t[a]), &rms_tail(task, a, w, &features));
                 }
                 cp.nonneg(&sum);
             }
@@ -411,4 +447,77 @@ pub fn solve_relaxation(
 /// parameters within the bounds balance the variant.
 pub fn solve_bounds_only(problem: &VariantProblem, max_iter: u32) -> Relaxed {
     solve_relaxation(problem, &[], Objective::Minimax, max_iter)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use counterpoise_model::sampling::SplitMix64;
+
+    /// `rms_tail` against the sample-by-sample norm it replaces: for random feature values the
+    /// norm of the compressed rows equals `w·‖τ‖` over the samples, τ computed directly from
+    /// the base torque and the sensitivities.
+    #[test]
+    fn compressed_rms_tail_has_the_norm_of_the_sampled_torque() {
+        let (samples, actuators, slots) = (51, 3, 1);
+        let mut rng = SplitMix64::new(7);
+        let mut uniform = || 2.0 * rng.next_f64() - 1.0;
+        let base: Vec<f64> = (0..samples * actuators).map(|_| 30.0 * uniform()).collect();
+        let sensitivity: Vec<Vec<f64>> = (0..slots * BODY_PARAMS)
+            .map(|_| (0..samples * actuators).map(|_| uniform()).collect())
+            .collect();
+        let task = TaskTorques {
+            task: 0,
+            samples,
+            actuators,
+            base,
+            sensitivity,
+        };
+        // Three features over two conic variables: m, μ_x (parts on π 0 and 1) and a mixed one.
+        let features = vec![
+            Feature {
+                expr: Affine::var(0).scaled(100.0),
+                parts: vec![(0, 0, 1.0)],
+            },
+            Feature {
+                expr: Affine::var(1).scaled(20.0),
+                parts: vec![(0, 1, 1.0)],
+            },
+            Feature {
+                expr: {
+                    let mut e = Affine::var(0);
+                    e.add_var(1, -0.5);
+                    e.constant = 0.3;
+                    e
+                },
+                parts: vec![(0, 4, 1.0), (0, 7, -2.0)],
+            },
+        ];
+        let w = 0.37;
+        for a in 0..actuators {
+            let tail = rms_tail(&task, a, w, &features);
+            assert_eq!(tail.len(), 1 + features.len());
+            for _ in 0..5 {
+                let x = [uniform(), uniform()];
+                let f: Vec<f64> = features.iter().map(|f| f.expr.eval(&x)).collect();
+                let direct: f64 = (0..samples)
+                    .map(|s| {
+                        let mut tau = task.base[s * actuators + a];
+                        for (k, feat) in features.iter().enumerate() {
+                            for &(slot, j, c) in &feat.parts {
+                                tau += f[k] * c * task.sens(slot, j)[s * actuators + a];
+                            }
+                        }
+                        (w * tau).powi(2)
+                    })
+                    .sum::<f64>()
+                    .sqrt();
+                let compressed = tail.iter().map(|e| e.eval(&x).powi(2)).sum::<f64>().sqrt();
+                assert!(
+                    (compressed - direct).abs() <= 1e-12 * direct,
+                    "{compressed} vs {direct}"
+                );
+            }
+        }
+    }
 }
