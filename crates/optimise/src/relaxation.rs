@@ -30,7 +30,7 @@ use std::sync::Arc;
 use counterpoise_dynamics::params::BODY_PARAMS;
 use nalgebra::{DMatrix, DVector};
 
-use crate::clarabel_map::{Affine, ConicProblem, ConicSolution};
+use crate::clarabel_map::{Affine, ConicProblem, ConicSolution, ConicStatus};
 use crate::problem::{Objective, VariantProblem};
 use crate::torque::TaskTorques;
 
@@ -416,23 +416,18 @@ pub fn solve_relaxation(
             }
         }
     }
-    // Peak limits, relative to each limit.
+    // Peak limits, relative to each limit: −1 ≤ τ_s/L ≤ 1 at every working-set sample.
+    let mut peaks: Vec<Affine> = Vec::new();
     for task in tasks {
         for (a, lim) in problem.peak_limits.iter().enumerate() {
             if let Some(lim) = *lim {
                 for s in 0..task.samples {
-                    let e = torque(task, s, a).scaled(1.0 / lim);
-                    let mut up = e.scaled(-1.0);
-                    up.constant += 1.0;
-                    cp.nonneg(&up);
-                    let mut down = e;
-                    down.constant += 1.0;
-                    cp.nonneg(&down);
+                    peaks.push(torque(task, s, a).scaled(1.0 / lim));
                 }
             }
         }
     }
-    let solution = cp.solve(max_iter);
+    let solution = solve_with_lazy_peaks(&mut cp, &peaks, max_iter);
     let zv = DVector::from_iterator(d, z.iter().zip(&dz).map(|(&j, &s)| solution.x[j] * s));
     Relaxed {
         bound: tau_scale
@@ -441,6 +436,61 @@ pub fn solve_relaxation(
         z: zv,
         solution,
     }
+}
+
+/// Below this relative level a peak row is far enough from active to be left out of a round.
+const PEAK_ROW_INACTIVE: f64 = 0.98;
+/// Rounds of the peak-row cutting planes before every row is added.
+const PEAK_ROUNDS: usize = 8;
+
+/// Adds `−1 ≤ e ≤ 1` to the problem.
+fn add_peak_row(cp: &mut ConicProblem, e: &Affine) {
+    let mut up = e.scaled(-1.0);
+    up.constant += 1.0;
+    cp.nonneg(&up);
+    let mut down = e.clone();
+    down.constant += 1.0;
+    cp.nonneg(&down);
+}
+
+/// Solves `cp` with the peak rows `−1 ≤ e ≤ 1` added lazily (cutting planes).
+///
+/// A working set of a few tasks has thousands of peak rows (51 samples × actuators × tasks,
+/// two each), most of them far from active, and they dominate the solver's work. Each round
+/// solves with the rows known to matter, then adds every row the solution violates or nearly
+/// meets (above [`PEAK_ROW_INACTIVE`]). The problem of any round is a relaxation of the full
+/// one, so its bound is a valid lower bound and its infeasibility proves the full problem's;
+/// the last round's solution meets every row left out with a margin, so it is the full
+/// problem's optimum. A round that clarabel does not solve, or too many rounds, fall back to
+/// the full problem, solved as it always was.
+fn solve_with_lazy_peaks(cp: &mut ConicProblem, peaks: &[Affine], max_iter: u32) -> ConicSolution {
+    let mut added = vec![false; peaks.len()];
+    for _ in 0..PEAK_ROUNDS {
+        let solution = cp.solve(max_iter);
+        if solution.status.is_infeasible() {
+            return solution;
+        }
+        if solution.status != ConicStatus::Solved {
+            break;
+        }
+        let mut any = false;
+        for (k, e) in peaks.iter().enumerate() {
+            if !added[k] && e.eval(&solution.x).abs() > PEAK_ROW_INACTIVE {
+                add_peak_row(cp, e);
+                added[k] = true;
+                any = true;
+            }
+        }
+        if !any {
+            return solution;
+        }
+    }
+    for (k, e) in peaks.iter().enumerate() {
+        if !added[k] {
+            add_peak_row(cp, e);
+        }
+    }
+    cp.solve(max_iter)
 }
 
 /// The relaxation of the bounds alone (no tasks, no objective): its infeasibility proves that no
