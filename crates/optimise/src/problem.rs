@@ -333,7 +333,10 @@ impl VariantProblem {
             let mu: Vec<f64> = (0..c.axes.len()).map(|k| x[c.column + 1 + k]).collect();
             let mu_n = norm(&mu);
             let [rlo, rhi] = c.bounds.radius;
-            let rscale = (rhi * hi).max(1e-9);
+            // Relative to the radius bound at this mass, as the final verification measures the
+            // radius |μ|/m: at a small mass a violation that is tiny against `r_hi·m_hi` is a
+            // large one of the radius.
+            let rscale = (rhi * m.max(c.min_mass())).max(1e-9 * hi.max(1e-9));
             v.push((mu_n - rhi * m) / rscale);
             v.push((rlo * m - mu_n) / rscale);
             let _ = lo;

@@ -220,3 +220,51 @@ fn a_spring_whose_anchor_balance_fixes_is_realized_on_the_restricted_family() {
         );
     }
 }
+
+/// The lifted radius check measures what the final verification measures, the radius
+/// `|μ|/m` against its bound: a counterweight at its smallest mass whose radius exceeds the
+/// bound by 1e-6 (relative) is a violation of 1e-6 in both, not 1e-6·m/m_hi in the first
+/// (which accepted such points and left the variant undecided at the verification).
+#[test]
+fn the_lifted_radius_check_is_relative_to_the_counterweights_own_mass() {
+    let json = common::case_json("palletizer.json");
+    let model = common::model(&json);
+    let ctx = counterpoise_optimise::Context::new(&model, None).unwrap();
+    let set: Vec<usize> = ["m4", "m7", "K62"]
+        .iter()
+        .map(|l| {
+            ctx.catalogue
+                .entries
+                .iter()
+                .position(|e| &e.label == l)
+                .unwrap()
+        })
+        .collect();
+    let problem = counterpoise_optimise::problem::VariantProblem::new(
+        &ctx.model,
+        &ctx.catalogue,
+        &ctx.bounds,
+        &set,
+        counterpoise_balance::linear::solve(&ctx.basis, &set),
+        |b| ctx.torques.slot_of(b),
+    )
+    .unwrap();
+    let m7 = &problem.counterweights[1];
+    assert_eq!(m7.label, "m7");
+    let rhi = m7.bounds.radius[1];
+    let m = m7.min_mass();
+    let mut x = nalgebra::DVector::zeros(problem.particular.len());
+    // m4 inside its bounds, m7 at its smallest mass and 1e-6 beyond its radius.
+    let m4 = &problem.counterweights[0];
+    x[m4.column] = 250.0;
+    x[m4.column + 1] = 250.0 * 0.1;
+    x[m7.column] = m;
+    x[m7.column + 1] = m * rhi * (1.0 + 1e-6);
+    // K62 in the middle of its stiffness range, anchors at the frames' origins.
+    x[problem.springs[0].column] = 5000.0;
+    let worst = problem
+        .bound_violations(&x)
+        .into_iter()
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!((worst - 1e-6).abs() < 1e-9, "largest violation {worst}");
+}
