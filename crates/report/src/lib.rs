@@ -48,11 +48,13 @@
 
 pub mod charts;
 pub mod csv;
+pub mod decision;
 pub mod format;
 pub mod html;
 pub mod indicators;
 pub mod markdown;
 pub mod output;
+pub mod practical;
 pub mod ranking;
 pub mod results;
 pub mod svg;
@@ -62,6 +64,8 @@ pub mod text;
 pub use indicators::{
     DeltaR, IndicatorError, JointReaction, JointVariation, delta_r, percent_variation,
 };
+pub use decision::{Decision, Recommendation, decide};
+pub use practical::{PracticalFigures, SpringPeak};
 pub use output::{OutputError, read_results, regenerate, write_atomic, write_outputs};
 pub use ranking::{Class, RankItem, Ranking, RankingError, RankingOptions, rank};
 pub use results::{
