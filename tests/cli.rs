@@ -70,8 +70,8 @@ fn variants_json_lists_every_variant_with_elements_and_status() {
 
 #[test]
 fn variants_are_identical_with_one_and_two_threads() {
-    let one = counterpoise(&["--jobs", "1", "variants", "cases/palletizer.json", "--json"]);
-    let two = counterpoise(&["--jobs", "2", "variants", "cases/palletizer.json", "--json"]);
+    let one = counterpoise(&["variants", "cases/palletizer.json", "--json", "--jobs", "1"]);
+    let two = counterpoise(&["variants", "cases/palletizer.json", "--json", "--jobs", "2"]);
     let strip = |o: &Output| {
         let mut doc: serde_json::Value = serde_json::from_str(&stdout(o)).unwrap();
         doc["seconds"] = serde_json::Value::Null;
@@ -279,7 +279,10 @@ fn usage_errors_exit_with_code_2() {
             "--series",
             "s.json",
         ],
-        &["--jobs", "0", "check", "cases/pendulum.json"],
+        &["check", "cases/pendulum.json", "--jobs", "0"],
+        // `report` and `import-urdf` have no parallel stage, so no --jobs
+        &["report", "out/pendulum", "--jobs", "2"],
+        &["run", "cases/pendulum.json", "--tolerance", "-1"],
         &["run", "cases/pendulum.json", "--resolution", "fine"],
     ] {
         let out = counterpoise(args);

@@ -85,7 +85,7 @@ pub fn all(r: &RunResults) -> Vec<Chart> {
 }
 
 /// Bars beyond this are clipped: twice the largest |ΔQTR| or |ΔQIT| of the ranked variants, at
-/// least 10 percentage points, so an outlier ΔR (+21768 % on the pendulum) cannot flatten the
+/// least 10 percentage points, rounded up to a multiple of 10, so an outlier ΔR (+21768 % on the pendulum) cannot flatten the
 /// motor indicators.
 pub fn bar_clip(r: &RunResults) -> f64 {
     let motor = r
@@ -94,7 +94,8 @@ pub fn bar_clip(r: &RunResults) -> f64 {
         .flat_map(|v| [v.dqtr, v.dqit])
         .flatten()
         .fold(0.0f64, |m, x| m.max(x.abs()));
-    (2.0 * motor).max(10.0)
+    // Rounded up to a multiple of 10, so the note reads "beyond ±70", not "±64.19".
+    ((2.0 * motor).max(10.0) / 10.0).ceil() * 10.0
 }
 
 /// `chunks` of about equal size (33 → 11, 11, 11, never 16, 16, 1).
@@ -129,8 +130,11 @@ fn ranking_bars(r: &RunResults) -> Vec<Chart> {
     let mut groups: Vec<(String, Vec<&VariantRecord>, bool)> = Vec::new();
     let mut small: Vec<&VariantRecord> = Vec::new();
     for class in Class::ALL {
-        let mut vs: Vec<&VariantRecord> =
-            ranked.iter().copied().filter(|v| v.class == class).collect();
+        let mut vs: Vec<&VariantRecord> = ranked
+            .iter()
+            .copied()
+            .filter(|v| v.class == class)
+            .collect();
         vs.sort_by_key(|v| v.class_rank);
         let total = vs.len();
         if total < MIN_BARS {
@@ -156,10 +160,9 @@ fn ranking_bars(r: &RunResults) -> Vec<Chart> {
         }
     }
     let small_title = |vs: &[&VariantRecord]| {
-        let mut classes: Vec<Class> = vs.iter().map(|v| v.class).collect();
-        classes.dedup();
-        classes
+        Class::ALL
             .iter()
+            .filter(|c| vs.iter().any(|v| v.class == **c))
             .map(|c| c.title())
             .collect::<Vec<_>>()
             .join(" and ")
@@ -176,6 +179,7 @@ fn ranking_bars(r: &RunResults) -> Vec<Chart> {
             g.2 = true;
         }
         _ => {
+            small.sort_by_key(|v| v.rank);
             let title = format!("{} — ranking indicators", small_title(&small));
             groups.push((title, small, true));
         }
@@ -339,7 +343,11 @@ fn curve_class(r: &RunResults, variant: Option<usize>) -> Option<Class> {
 
 /// Line style of the `k`-th curve of a chart: the unbalanced robot dashed grey without marker,
 /// the variants in their class colour and marker, with a dash pattern by position.
-fn curve_style(r: &RunResults, k: usize, variant: Option<usize>) -> (String, Option<String>, Option<Marker>) {
+fn curve_style(
+    r: &RunResults,
+    k: usize,
+    variant: Option<usize>,
+) -> (String, Option<String>, Option<Marker>) {
     let class = curve_class(r, variant);
     let dash = match variant {
         None => Some("6 3".to_string()),

@@ -154,34 +154,56 @@ fn recommend(
     let mut steps: Vec<String> = Vec::new();
     let mut left = equivalent.clone();
     // 1. added mass
-    let best = left.iter().map(|v| added_mass(v)).fold(f64::INFINITY, f64::min);
-    narrow(&mut left, &mut steps, |v| added_mass(v) <= best + mass_margin, || {
-        let share = moving_mass
-            .filter(|m| *m > 0.0)
-            .map(|m| format!(", {:.1} % of the moving mass", best / m * 100.0))
-            .unwrap_or_default();
-        format!("the least added mass ({}{share})", mass(best))
-    });
+    let best = left
+        .iter()
+        .map(|v| added_mass(v))
+        .fold(f64::INFINITY, f64::min);
+    narrow(
+        &mut left,
+        &mut steps,
+        |v| added_mass(v) <= best + mass_margin,
+        || {
+            let share = moving_mass
+                .filter(|m| *m > 0.0)
+                .map(|m| format!(", {:.1} % of the moving mass", best / m * 100.0))
+                .unwrap_or_default();
+            format!("the least added mass ({}{share})", mass(best))
+        },
+    );
     // 2. ΔR
     let best = left
         .iter()
         .map(|v| v.dr.unwrap_or(0.0))
         .fold(f64::INFINITY, f64::min);
-    narrow(&mut left, &mut steps, |v| v.dr.unwrap_or(0.0) <= best + tolerance, || {
-        format!("the lowest ΔR ({} %)", percent(best))
-    });
+    narrow(
+        &mut left,
+        &mut steps,
+        |v| v.dr.unwrap_or(0.0) <= best + tolerance,
+        || format!("the lowest ΔR ({} %)", percent(best)),
+    );
     // 3. element count
     let best = left.iter().map(|v| elements(v)).min().unwrap_or(0);
-    narrow(&mut left, &mut steps, |v| elements(v) <= best, || {
-        format!("the fewest elements ({best})")
-    });
+    narrow(
+        &mut left,
+        &mut steps,
+        |v| elements(v) <= best,
+        || format!("the fewest elements ({best})"),
+    );
     // 4. spring force
-    let best = left.iter().map(|v| spring_force(v)).fold(f64::INFINITY, f64::min);
+    let best = left
+        .iter()
+        .map(|v| spring_force(v))
+        .fold(f64::INFINITY, f64::min);
     narrow(
         &mut left,
         &mut steps,
         |v| spring_force(v) <= best * (1.0 + FORCE_MARGIN),
-        || format!("the smallest peak spring force ({})", crate::format::force(best)),
+        || {
+            format!(
+                "the smallest peak spring force ({})",
+                crate::format::force(best)
+            )
+        },
     );
     // 5. rank: `left` is in rank order.
     let chosen = left[0];
@@ -189,8 +211,10 @@ fn recommend(
         steps.push(format!("the best rank ({})", chosen.rank.unwrap_or(0)));
     }
     let scope_name = match class {
-        None => String::new(),
-        Some(c) => format!(" {}", c.title().to_lowercase()),
+        None => "",
+        Some(Class::Counterweights) => " counterweight-only",
+        Some(Class::Springs) => " spring-only",
+        Some(Class::Hybrid) => " hybrid",
     };
     let reason = if equivalent.len() == 1 {
         format!(
@@ -301,11 +325,46 @@ mod tests {
     /// behind and outside the group.
     fn sample() -> Vec<VariantRecord> {
         vec![
-            v(10, 1, &["m4", "K43"], Class::Hybrid, (-54.22, -48.40, 3.70), (12.0, Some(900.0))),
-            v(11, 2, &["m4", "K52"], Class::Hybrid, (-54.20, -48.40, 8.13), (12.0, Some(700.0))),
-            v(20, 3, &["K32", "K42"], Class::Springs, (-54.05, -49.22, 0.0), (0.0, Some(5000.0))),
-            v(21, 4, &["K42", "K43"], Class::Springs, (-54.05, -49.22, 0.0), (0.0, Some(3000.0))),
-            v(30, 5, &["m4", "m5"], Class::Counterweights, (-52.66, -43.49, 10.37), (60.0, None)),
+            v(
+                10,
+                1,
+                &["m4", "K43"],
+                Class::Hybrid,
+                (-54.22, -48.40, 3.70),
+                (12.0, Some(900.0)),
+            ),
+            v(
+                11,
+                2,
+                &["m4", "K52"],
+                Class::Hybrid,
+                (-54.20, -48.40, 8.13),
+                (12.0, Some(700.0)),
+            ),
+            v(
+                20,
+                3,
+                &["K32", "K42"],
+                Class::Springs,
+                (-54.05, -49.22, 0.0),
+                (0.0, Some(5000.0)),
+            ),
+            v(
+                21,
+                4,
+                &["K42", "K43"],
+                Class::Springs,
+                (-54.05, -49.22, 0.0),
+                (0.0, Some(3000.0)),
+            ),
+            v(
+                30,
+                5,
+                &["m4", "m5"],
+                Class::Counterweights,
+                (-52.66, -43.49, 10.37),
+                (60.0, None),
+            ),
         ]
     }
 
@@ -354,7 +413,7 @@ mod tests {
         );
         assert_eq!(
             d.classes[0].reason,
-            "SB5 (m4 + m5) is the only counterweights only variant within 0.5 percentage points \
+            "SB5 (m4 + m5) is the only counterweight-only variant within 0.5 percentage points \
              of the best ΔQTR and ΔQIT."
         );
     }
@@ -362,18 +421,43 @@ mod tests {
     #[test]
     fn a_worse_qit_outside_the_tolerance_is_not_equivalent() {
         let vs = vec![
-            v(1, 1, &["m1"], Class::Counterweights, (-60.0, -50.0, 0.0), (5.0, None)),
+            v(
+                1,
+                1,
+                &["m1"],
+                Class::Counterweights,
+                (-60.0, -50.0, 0.0),
+                (5.0, None),
+            ),
             // ΔQTR 0.3 pp behind, ΔQIT 0.6 pp behind: not equivalent although lighter
-            v(2, 2, &["m2"], Class::Counterweights, (-59.7, -49.4, 0.0), (1.0, None)),
+            v(
+                2,
+                2,
+                &["m2"],
+                Class::Counterweights,
+                (-59.7, -49.4, 0.0),
+                (1.0, None),
+            ),
             // 0.4 and 0.5 pp behind (the bound is inclusive), lighter: recommended
-            v(3, 3, &["m3"], Class::Counterweights, (-59.6, -49.5, 0.0), (2.0, None)),
+            v(
+                3,
+                3,
+                &["m3"],
+                Class::Counterweights,
+                (-59.6, -49.5, 0.0),
+                (2.0, None),
+            ),
         ];
         let ranked: Vec<&VariantRecord> = vs.iter().collect();
         let o = decide(&ranked, 0.5, None).overall.unwrap();
         assert_eq!(o.equivalent, vec![1, 3]);
         assert_eq!(o.chosen, 3);
         // moving mass unknown: no share in the sentence
-        assert!(o.reason.contains("the least added mass (2.00 kg)"), "{}", o.reason);
+        assert!(
+            o.reason.contains("the least added mass (2.00 kg)"),
+            "{}",
+            o.reason
+        );
     }
 
     #[test]

@@ -36,6 +36,8 @@ table.kv td:first-child { color: var(--muted); padding-right: 18px; }
 .charts { display: flex; flex-wrap: wrap; gap: 18px; }
 .charts figure { margin: 0; border: 1px solid var(--line); border-radius: 4px; padding: 4px; }
 svg.chart { display: block; max-width: 100%; height: auto; }
+ul.why { margin: 4px 0 12px; padding-left: 20px; max-width: 980px; }
+ul.why li { margin: 3px 0; }
 ul.rel { margin: 4px 0 10px; padding-left: 20px; }
 ul.rel code { font: 12.5px/1.5 ui-monospace, SFMono-Regular, Menlo, Consolas, monospace; }
 details { margin: 8px 0; }
@@ -225,6 +227,11 @@ fn push_decision(h: &mut String, r: &RunResults, charts: &[Chart]) {
     }
     h.push_str("<h2>Which variant to build</h2>");
     h.push_str(&table(&recs, ""));
+    h.push_str("<ul class=\"why\">");
+    for (scope, reason) in tables::reasons(r) {
+        let _ = write!(h, "<li><b>{}.</b> {}</li>", esc(&scope), esc(&reason));
+    }
+    h.push_str("</ul>");
     let _ = write!(h, "<p class=\"note\"><b>Rule.</b> {}</p>", esc(&d.rule));
     h.push_str(&practical_note(r));
     push_charts(h, charts, Section::Decision);
@@ -270,14 +277,23 @@ pub fn not_ranked_summary(r: &RunResults) -> String {
         .counts
         .iter()
         .filter(|c| {
-            c.total > 0 && !matches!(c.status, VariantStatus::Feasible | VariantStatus::Infeasible)
+            c.total > 0
+                && !matches!(
+                    c.status,
+                    VariantStatus::Feasible | VariantStatus::Infeasible
+                )
         })
         .map(|c| format!("{} {} ({})", c.total, c.status.name(), c.status.meaning()))
         .collect();
     let total: usize = r
         .counts
         .iter()
-        .filter(|c| !matches!(c.status, VariantStatus::Feasible | VariantStatus::Infeasible))
+        .filter(|c| {
+            !matches!(
+                c.status,
+                VariantStatus::Feasible | VariantStatus::Infeasible
+            )
+        })
         .map(|c| c.total)
         .sum();
     format!("{total} variants not ranked: {}", parts.join("; "))

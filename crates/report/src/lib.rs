@@ -61,12 +61,14 @@ pub mod svg;
 pub mod tables;
 pub mod text;
 
+pub use decision::{Decision, Recommendation, decide};
 pub use indicators::{
     DeltaR, IndicatorError, JointReaction, JointVariation, delta_r, percent_variation,
 };
-pub use decision::{Decision, Recommendation, decide};
+pub use output::{
+    OutputError, read_results, regenerate, regenerate_with, write_atomic, write_outputs,
+};
 pub use practical::{PracticalFigures, SpringPeak};
-pub use output::{OutputError, read_results, regenerate, write_atomic, write_outputs};
 pub use ranking::{Class, RankItem, Ranking, RankingError, RankingOptions, rank};
 pub use results::{
     ActuatorSummary, CounterweightParams, CriticalTask, Curve, ElementInfo, ElementKind,

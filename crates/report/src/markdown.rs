@@ -27,6 +27,10 @@ pub fn render(r: &RunResults) -> String {
     let recs = tables::recommendations(r);
     if let (Some(d), false) = (&r.decision, recs.rows.is_empty()) {
         section(&mut s, "Which variant to build", &recs);
+        for (scope, reason) in tables::reasons(r) {
+            let _ = writeln!(s, "- **{}.** {}", esc(&scope), esc(&reason));
+        }
+        s.push('\n');
         let _ = writeln!(s, "**Rule.** {}\n", esc(&d.rule));
         let group = tables::equivalent_group(r);
         if group.rows.len() > 1 {
@@ -100,7 +104,11 @@ pub fn render(r: &RunResults) -> String {
     }
     let others = tables::not_ranked(r);
     if !others.rows.is_empty() {
-        let _ = writeln!(s, "## Variants not ranked\n\n{}.\n", esc(&crate::html::not_ranked_summary(r)));
+        let _ = writeln!(
+            s,
+            "## Variants not ranked\n\n{}.\n",
+            esc(&crate::html::not_ranked_summary(r))
+        );
         table(&mut s, &others);
     }
     if !ranked.is_empty() {

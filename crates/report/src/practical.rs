@@ -74,7 +74,8 @@ impl PracticalFigures {
         moving_mass: Option<f64>,
         springs: Vec<SpringPeak>,
     ) -> PracticalFigures {
-        let added_mass: f64 = p.counterweights.iter().map(|c| c.mass).sum();
+        // A fold from +0: `sum` of no masses is −0.0, which would print as "-0.0 %".
+        let added_mass = p.counterweights.iter().fold(0.0, |a, c| a + c.mass);
         let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         let max = |it: &mut dyn Iterator<Item = f64>| it.reduce(f64::max);
         PracticalFigures {
@@ -129,6 +130,7 @@ mod tests {
         assert_eq!(f.peak_spring_elongation, Some(0.6));
         let none = PracticalFigures::new(&PhysicalParameters::default(), None, vec![]);
         assert_eq!(none.added_mass, 0.0);
+        assert!(none.added_mass.is_sign_positive());
         assert_eq!(none.added_mass_percent, None);
         assert_eq!(none.peak_spring_force, None);
         assert_eq!(none.peak_counterweight_offset, None);

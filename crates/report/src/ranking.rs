@@ -278,7 +278,10 @@ mod tests {
     #[test]
     fn resolution_boundary() {
         // Gap below the resolution ties (ΔR decides); gap of exactly the resolution separates.
-        let opts = RankingOptions { resolution: 0.25, ..Default::default() };
+        let opts = RankingOptions {
+            resolution: 0.25,
+            ..Default::default()
+        };
         let tie = vec![
             item("x", Class::Counterweights, -10.0, 0.0, 5.0),
             item("y", Class::Counterweights, -10.0 + 0.125, 0.0, 1.0),
@@ -302,7 +305,10 @@ mod tests {
         ];
         assert_eq!(keys(&far, &rank(&far, &d).unwrap()), ["x", "y"]);
         // Zero resolution: exact comparison.
-        let exact = RankingOptions { resolution: 0.0, ..Default::default() };
+        let exact = RankingOptions {
+            resolution: 0.0,
+            ..Default::default()
+        };
         assert_eq!(keys(&near, &rank(&near, &exact).unwrap()), ["x", "y"]);
     }
 
@@ -372,7 +378,13 @@ mod tests {
             Err(RankingError::NotFinite { .. })
         ));
         assert!(matches!(
-            rank(&[], &RankingOptions { resolution: -1.0, ..Default::default() }),
+            rank(
+                &[],
+                &RankingOptions {
+                    resolution: -1.0,
+                    ..Default::default()
+                }
+            ),
             Err(RankingError::BadResolution(_))
         ));
         assert!(

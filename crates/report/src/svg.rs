@@ -217,9 +217,10 @@ pub struct LineChart {
     pub height: f64,
 }
 
-/// The series with values below the noise floor set to exactly zero, and the floor if it
-/// changed any value.
-pub fn denoise(series: &[LineSeries], scale: Option<f64>) -> (Vec<LineSeries>, Option<f64>) {
+/// The series with values below the noise floor set to exactly zero, the floor, and the labels
+/// of the series that had nonzero values and are now all zero (the ones the reader must be
+/// told about: elsewhere the change is far below a pixel).
+pub fn denoise(series: &[LineSeries], scale: Option<f64>) -> (Vec<LineSeries>, f64, Vec<String>) {
     let own = series
         .iter()
         .flat_map(|s| s.y.iter())
@@ -227,21 +228,24 @@ pub fn denoise(series: &[LineSeries], scale: Option<f64>) -> (Vec<LineSeries>, O
         .fold(0.0f64, |m, v| m.max(v.abs()));
     let scale = scale.unwrap_or(own).max(own);
     let floor = NOISE_FLOOR * scale;
-    let mut changed = false;
+    let mut silenced = Vec::new();
     let out = series
         .iter()
         .map(|s| {
             let mut s = s.clone();
+            let had_signal = s.y.iter().any(|v| v.is_finite() && *v != 0.0);
             for v in &mut s.y {
-                if v.is_finite() && *v != 0.0 && v.abs() < floor {
+                if v.is_finite() && v.abs() < floor {
                     *v = 0.0;
-                    changed = true;
                 }
+            }
+            if had_signal && s.y.iter().all(|v| *v == 0.0 || !v.is_finite()) {
+                silenced.push(s.label.clone());
             }
             s
         })
         .collect();
-    (out, changed.then_some(floor))
+    (out, floor, silenced)
 }
 
 /// One legend entry.
@@ -400,20 +404,35 @@ fn y_axis(out: &mut String, f: &Frame, y_label: &str) {
     );
 }
 
-/// A small grey note line inside a chart (e.g. the noise floor).
-fn note_line(out: &mut String, text: &str, x: f64, y: f64) {
-    let _ = write!(
-        out,
-        r##"<text x="{x:.1}" y="{y:.1}" font-size="10.5" fill="#555555" font-style="italic">{}</text>"##,
-        escape_html(text)
-    );
+/// A small grey note inside a chart (e.g. the noise floor), wrapped at word boundaries to
+/// `width`; returns the height used.
+fn note_lines(out: &mut String, text: &str, x: f64, y: f64, width: f64) -> f64 {
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split(' ') {
+        match lines.last_mut() {
+            Some(line) if text_width(&format!("{line} {word}"), 10.5) <= width => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    for (k, line) in lines.iter().enumerate() {
+        let _ = write!(
+            out,
+            r##"<text x="{x:.1}" y="{:.1}" font-size="10.5" fill="#555555" font-style="italic">{}</text>"##,
+            y + 14.0 * k as f64,
+            escape_html(line)
+        );
+    }
+    14.0 * lines.len() as f64
 }
 
 /// Renders a line chart as an `<svg>` element.
 pub fn line_chart(chart: &LineChart) -> String {
     let (width, height) = (chart.width, chart.height);
     let right = 18.0;
-    let (series, floor) = denoise(&chart.series, chart.noise_scale);
+    let (series, floor, silenced) = denoise(&chart.series, chart.noise_scale);
     let (y_lo, y_hi) = range(
         series.iter().flat_map(|s| s.y.iter().copied()),
         chart.include_zero,
@@ -433,29 +452,30 @@ pub fn line_chart(chart: &LineChart) -> String {
     let (legend_svg, legend_h) = legend(&items, left, legend_y, width - left - right);
     out.push_str(&legend_svg);
     let mut top = legend_y + legend_h + 4.0;
-    if let Some(floor) = floor {
-        let all_zero = series.iter().all(|s| s.y.iter().all(|v| *v == 0.0));
+    if !silenced.is_empty() {
         let unit = if chart.y_unit.is_empty() {
             String::new()
         } else {
             format!(" {}", chart.y_unit)
         };
-        let text = if all_zero {
-            format!(
-                "every value is below the noise floor ({floor:.1e}{unit}, 1e-6 of the figure's scale): drawn as zero"
-            )
+        let who = if silenced.len() == series.len() {
+            "every curve".to_string()
         } else {
-            format!("values below {floor:.1e}{unit} (1e-6 of the figure's scale) drawn as zero")
+            silenced.join(", ")
         };
-        note_line(&mut out, &text, left, top + 6.0);
-        top += 16.0;
+        let text = format!(
+            "{who}: all values below the noise floor ({floor:.1e}{unit}, 1e-6 of the figure's scale), drawn as zero"
+        );
+        top += note_lines(&mut out, &text, left, top + 6.0, width - left - right) + 2.0;
     }
     let bottom = 50.0;
     let xs = || series.iter().flat_map(|s| s.x.iter().copied());
     let (x_lo, x_hi) = {
         // No padding on x: curves span the task.
         let lo = xs().filter(|x| x.is_finite()).fold(f64::INFINITY, f64::min);
-        let hi = xs().filter(|x| x.is_finite()).fold(f64::NEG_INFINITY, f64::max);
+        let hi = xs()
+            .filter(|x| x.is_finite())
+            .fold(f64::NEG_INFINITY, f64::max);
         if lo.is_finite() && hi > lo {
             (lo, hi)
         } else {
@@ -605,16 +625,11 @@ pub fn bar_chart(chart: &BarChart) -> String {
     out.push_str(&legend_svg);
     let mut top = legend_y + legend_h + 4.0;
     if let (true, Some(c)) = (clipped_any, clip) {
-        note_line(
-            &mut out,
-            &format!(
-                "bars beyond ±{} are cut (zigzag) and their value printed",
-                crate::format::compact(c)
-            ),
-            left,
-            top + 6.0,
+        let text = format!(
+            "bars beyond ±{} are cut (zigzag) and their value printed",
+            crate::format::compact(c)
         );
-        top += 16.0;
+        top += note_lines(&mut out, &text, left, top + 6.0, width - left - right) + 2.0;
     }
     let bottom = 44.0;
     let plot_w = width - left - right;
@@ -790,6 +805,8 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
     let top = legend_y + legend_h + 8.0;
     let bottom = 50.0;
     let (x_lo, x_hi) = range(chart.points.iter().map(|p| p.x), true);
+    // Room left of the lightest points for their markers, clear of the tick labels.
+    let x_lo = x_lo - 0.04 * (x_hi - x_lo);
     let f = Frame {
         left,
         top,
@@ -989,22 +1006,30 @@ mod tests {
         // A balanced motor's static torque: ±1e-11 N·m of round-off, in a figure whose other
         // charts reach 250 N·m. The floor is 1e-6 · 250 = 2.5e-4 N·m: every value is below it.
         let noise = vec![1e-11, -2e-11, 0.0, 1.5e-11, -0.7e-11];
-        let (out, floor) = denoise(&[series("SB1", noise.clone())], Some(250.0));
-        assert_eq!(floor, Some(2.5e-4));
+        let (out, floor, silenced) = denoise(&[series("SB1", noise.clone())], Some(250.0));
+        assert_eq!(floor, 2.5e-4);
         assert!(out[0].y.iter().all(|v| *v == 0.0));
+        assert_eq!(silenced, vec!["SB1".to_string()]);
         let svg = line_chart(&chart(vec![series("SB1", noise.clone())], Some(250.0)));
-        assert!(svg.contains("every value is below the noise floor (2.5e-4 N·m"), "{svg}");
+        assert!(
+            svg.contains("every curve: all values below the noise floor (2.5e-4 N·m"),
+            "{svg}"
+        );
         // The axis then shows the fallback ±1 range, not ±2e-11.
         assert!(!svg.contains("e-11"), "{svg}");
-        // Values above the floor are kept exactly; a mixed series gets the partial note.
+        // Values above the floor are kept exactly; a series with signal is not silenced, and
+        // there is then no note (the change is far below a pixel).
         let mixed = vec![3.0, 1e-9, -4.0];
-        let (out, floor) = denoise(&[series("UB", mixed)], None);
+        let (out, floor, silenced) = denoise(&[series("UB", mixed.clone())], None);
         assert_eq!(out[0].y, vec![3.0, 0.0, -4.0]);
-        assert_eq!(floor, Some(4e-6));
+        assert_eq!(floor, 4e-6);
+        assert!(silenced.is_empty());
+        let svg = line_chart(&chart(vec![series("UB", mixed)], None));
+        assert!(!svg.contains("noise floor"), "{svg}");
         // Without a figure scale the chart's own scale applies: 1e-11 alone is its own signal.
-        let (out, floor) = denoise(&[series("SB1", noise.clone())], None);
+        let (out, _, silenced) = denoise(&[series("SB1", noise.clone())], None);
         assert_eq!(out[0].y, noise);
-        assert_eq!(floor, None);
+        assert!(silenced.is_empty());
     }
 
     #[test]
@@ -1028,7 +1053,10 @@ mod tests {
             title: "Pendulum".into(),
             y_label: "%".into(),
             categories: vec![("SB1".into(), "m1".into()), ("SB2".into(), "K10".into())],
-            series: vec![("ΔQTR".into(), PALETTE[1].into()), ("ΔR".into(), PALETTE[5].into())],
+            series: vec![
+                ("ΔQTR".into(), PALETTE[1].into()),
+                ("ΔR".into(), PALETTE[5].into()),
+            ],
             values: vec![vec![-90.0, 21768.0], vec![-85.0, 0.0]],
             clip: Some(180.0),
             min_width: 300.0,
@@ -1047,7 +1075,11 @@ mod tests {
         b.marker = Some(Marker::Triangle);
         let svg = line_chart(&chart(vec![a, b], None));
         // 16 samples: a marker every 2; series 0 starts at 0, series 1 at 1: 8 each, + legend.
-        assert_eq!(svg.matches("<rect x=").count() - 2, 8 + 1, "squares (minus background, frame)");
+        assert_eq!(
+            svg.matches("<rect x=").count() - 2,
+            8 + 1,
+            "squares (minus background, frame)"
+        );
         assert_eq!(svg.matches("<polygon").count(), 8 + 1, "triangles");
     }
 }

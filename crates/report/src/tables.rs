@@ -272,7 +272,7 @@ pub fn ranking(r: &RunResults) -> Table {
                 Cell::num(opt(optim.and_then(|o| o.objective), value)),
                 Cell::num(opt(optim.and_then(|o| o.gap), |g| format!("{:.1e}", g))),
                 Cell::text(if v.tie_broken_by_label {
-                    "tie broken by labels"
+                    "label tie-break"
                 } else {
                     ""
                 }),
@@ -598,7 +598,6 @@ pub fn recommendations(r: &RunResults) -> Table {
         "ΔR [%]",
     ];
     header.extend(PRACTICAL_HEADER);
-    header.push("Why");
     let mut t = Table::new(&header);
     let Some(d) = &r.decision else {
         return t;
@@ -622,7 +621,6 @@ pub fn recommendations(r: &RunResults) -> Table {
             Cell::num(opt(v.dr, percent)),
         ];
         row.extend(practical_cells(v));
-        row.push(Cell::prose(&rec.reason));
         t.push(row, k == 1);
     }
     t.without_empty_columns()
@@ -632,7 +630,13 @@ pub fn recommendations(r: &RunResults) -> Table {
 /// order; the pick is marked.
 pub fn equivalent_group(r: &RunResults) -> Table {
     let mut header = vec![
-        "Rank", "Variant", "Elements", "Class", "ΔQTR [%]", "ΔQIT [%]", "ΔR [%]",
+        "Rank",
+        "Variant",
+        "Elements",
+        "Class",
+        "ΔQTR [%]",
+        "ΔQIT [%]",
+        "ΔR [%]",
     ];
     header.extend(PRACTICAL_HEADER);
     header.push("");
@@ -678,4 +682,22 @@ pub fn practical(r: &RunResults) -> Table {
         t.push(row, false);
     }
     t.without_empty_columns()
+}
+
+/// The recommendations' reasons, one sentence each, headed by their scope.
+pub fn reasons(r: &RunResults) -> Vec<(String, String)> {
+    let Some(d) = &r.decision else {
+        return Vec::new();
+    };
+    d.overall
+        .iter()
+        .chain(&d.classes)
+        .map(|rec| {
+            let scope = match rec.class {
+                None => "Overall".to_string(),
+                Some(c) => c.title().to_string(),
+            };
+            (scope, rec.reason.clone())
+        })
+        .collect()
 }

@@ -460,11 +460,17 @@ fn writes_all_outputs_and_regenerates() {
         charts[1].title,
         "Counterweights only and Springs only and Hybrid — ranking indicators"
     );
-    assert_eq!(charts[1].svg.matches("<title>SB").count(), 5 * 3, "5 groups of 3 bars");
+    assert_eq!(
+        charts[1].svg.matches("<title>SB").count(),
+        5 * 3,
+        "5 groups of 3 bars"
+    );
     // The decision comes first, in both reports.
     let decision = html.find("Which variant to build").unwrap();
     assert!(decision < html.find("<h2>Summary</h2>").unwrap());
-    assert!(html.contains("<summary>Balance relations and free directions of the 5 ranked variants</summary>"));
+    assert!(html.contains(
+        "<summary>Balance relations and free directions of the 5 ranked variants</summary>"
+    ));
     assert_eq!(svgs, charts.len());
     assert!(tables >= 8);
     assert!(!html.contains("http://") || !html.contains("href="));
