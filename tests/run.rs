@@ -115,7 +115,8 @@ fn run_writes_every_output_and_report_regenerates_them() {
             v["elements"].as_array().unwrap().len()
         );
         let springs = params["springs"].as_array().unwrap();
-        for (s, peak) in springs.iter().zip(p["springs"].as_array().unwrap()) {
+        let peaks = p["springs"].as_array().cloned().unwrap_or_default();
+        for (s, peak) in springs.iter().zip(&peaks) {
             assert_eq!(s["label"], peak["label"]);
             let expected = num(s, "stiffness") * num(peak, "elongation");
             assert!(

@@ -100,7 +100,7 @@ pub fn derived_bounds_note(model: &Model) -> Option<String> {
         return None;
     }
     let scale = counterpoise_model::MechanismScale::of(&model.bodies, model.gravity);
-    let g = |x: f64| format!("{}", counterpoise_report::format::compact(x));
+    let g = counterpoise_report::format::compact;
     let parts: Vec<String> = b
         .derived_bounds
         .iter()

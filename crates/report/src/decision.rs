@@ -420,7 +420,7 @@ mod tests {
 
     #[test]
     fn a_worse_qit_outside_the_tolerance_is_not_equivalent() {
-        let vs = vec![
+        let vs = [
             v(
                 1,
                 1,

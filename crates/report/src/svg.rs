@@ -52,7 +52,7 @@ pub fn nice_ticks(lo: f64, hi: f64, target: usize) -> (Vec<f64>, f64) {
 /// Tick label with as many decimals as the step needs; steps below 1e-3 or from 1e5 up are
 /// written with an exponent (`2e-11`, `1.5e6`) so a label never runs to a dozen digits.
 fn tick_label(v: f64, step: f64) -> String {
-    if step < 1e-3 || step >= 1e5 {
+    if !(1e-3..1e5).contains(&step) {
         if v.abs() < step * 1e-9 {
             return "0".into();
         }

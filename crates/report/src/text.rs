@@ -38,14 +38,11 @@ pub fn summary(r: &RunResults) -> String {
     s.push_str("Best variant of each class (ΔQTR, ΔQIT in % vs unbalanced, negative = reduction; ΔR ≥ 0):\n");
     s.push_str(&aligned(&best));
     if let Some(rec) = r.decision.as_ref().and_then(|d| d.overall.as_ref()) {
-        if let Some(v) = r.variant(rec.chosen) {
-            let _ = writeln!(
-                s,
-                "\nRecommended: {}. {}\n(one per class and the rule in report.html)",
-                v.display_name(),
-                rec.reason
-            );
-        }
+        let _ = writeln!(
+            s,
+            "\nRecommended: {}\n(one per class, and the rule, in report.html)",
+            rec.reason
+        );
     }
     let mut ranking = tables::ranking(r);
     let shown = ranking.rows.len().min(SUMMARY_RANKS);
