@@ -790,11 +790,15 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
         })
         .collect();
     items.push(LegendItem {
-        label: format!(
-            "marker area ∝ {} (largest: {} % and above)",
-            chart.size_label,
-            crate::format::compact(chart.size_max)
-        ),
+        label: if chart.size_max > 0.0 {
+            format!(
+                "marker area ∝ {} (largest: {} % and above)",
+                chart.size_label,
+                crate::format::compact(chart.size_max)
+            )
+        } else {
+            format!("{} is 0 for every variant", chart.size_label)
+        },
         color: "#ffffff".into(),
         dash: None,
         marker: None,
