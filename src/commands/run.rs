@@ -124,7 +124,13 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     })?;
 
     // Phase 2: optimisation of every balanced variant, re-evaluated over all tasks.
-    let optimised = timer.time("Phase 2: optimisation of the balanced variants", || {
+    let balanced_count = found
+        .variants
+        .iter()
+        .filter(|v| v.status == Status::Balanced)
+        .count();
+    let phase_name = format!("Phase 2: optimisation of the {balanced_count} balanced variants");
+    let optimised = timer.time(&phase_name, || {
         let context = Context::new(&model, Some(unbalanced.clone()))?;
         let settings = OptimiseOptions {
             objective: if options.minimax {

@@ -53,6 +53,12 @@ pub fn summary(r: &RunResults) -> String {
     if hidden > 0 {
         let _ = writeln!(s, "… and {hidden} more in ranking.csv / report.html");
     }
+    if r.ranked().iter().any(|v| v.optimiser.is_some()) {
+        s.push_str(
+            "Objective: what the optimiser minimised (RMS*, Eq. 11, or QTR with --minimax), N·m; \
+             Gap: (objective − certified lower bound)/objective.\n",
+        );
+    }
     s
 }
 
