@@ -41,7 +41,9 @@
 //! ```
 //!
 //! Modules, one job each: [`indicators`] (Eqs. 15–21), [`ranking`] (lexicographic order at a
-//! resolution), [`results`] (the schema and `finalize`), [`tables`] (the tables both reports
+//! resolution), [`practical`] (added mass, element count, spring and offset peaks),
+//! [`decision`] (equivalence groups and recommendations), [`results`] (the schema and
+//! `finalize`), [`tables`] (the tables both reports
 //! share), [`svg`] (hand-written charts), [`charts`] (which charts), [`html`], [`markdown`],
 //! [`csv`], [`text`] (terminal summary), [`output`] (atomic files), [`format`] (numbers and
 //! escaping).

@@ -631,8 +631,16 @@ fn terminal_summary() {
         .lines()
         .skip_while(|l| !l.starts_with("Ranking (top 5):"))
         .skip(1)
+        .take_while(|l| l.starts_with("  "))
         .collect();
     assert_eq!(ranking.len(), 1 + 5, "header and five rows: {s}");
+    // The optimiser's columns are explained under the table.
+    assert!(
+        s.contains("\nObjective: what the optimiser minimised"),
+        "{s}"
+    );
+    // The overall recommendation is stated.
+    assert!(s.contains("\nRecommended: "), "{s}");
     let mut ranked: Vec<(usize, String)> = r
         .variants
         .iter()
