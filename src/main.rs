@@ -11,9 +11,6 @@ use clap::{Parser, Subcommand};
 #[derive(Parser, Debug)]
 #[command(name = "counterpoise", version, about, long_about = None)]
 struct Cli {
-    /// Worker threads for parallel stages (default: all cores). Results do not depend on it.
-    #[arg(long, global = true)]
-    jobs: Option<usize>,
     /// Lift (or lower) a resource limit, e.g. `--limit variants=100000`; repeatable. Names:
     /// file-bytes, parameters, list-items, expression-length, expression-depth, grid-points,
     /// samples, task-samples, dmax, variants (defaults in docs/case-format.md, Limits).
@@ -23,12 +20,23 @@ struct Cli {
     command: Command,
 }
 
+/// The option of the commands with parallel stages (not `report`, not `import-urdf`).
+#[derive(clap::Args, Debug, Clone, Copy)]
+struct Jobs {
+    /// Worker threads for the parallel stages (default: all cores). Results do not depend on
+    /// it.
+    #[arg(long, value_name = "N")]
+    jobs: Option<usize>,
+}
+
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Validate a case file and print a summary of the mechanism.
     Check {
         /// Case file (JSON).
         case: PathBuf,
+        #[command(flatten)]
+        jobs: Jobs,
     },
     /// Find every set of at most Dmax balancing elements that balances the mechanism exactly.
     Variants {
@@ -40,6 +48,8 @@ enum Command {
         /// Print the full results as JSON instead of tables.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        jobs: Jobs,
     },
     /// Phase 1: motor torques, joint reactions and the paper's indicators of the unbalanced
     /// mechanism over its task grid.
@@ -55,7 +65,8 @@ enum Command {
         /// Skip the joint reactions (motor torques only: much faster).
         #[arg(long)]
         no_reactions: bool,
-        /// One task `I,J` (grid indices) to write as a time series with --series.
+        /// One task `I,J` (grid indices, also written `I→J`) to write as a time series with
+        /// --series.
         #[arg(long, value_parser = parse_task, requires = "series")]
         task: Option<(usize, usize)>,
         /// File for the time series of --task (JSON).
@@ -65,6 +76,8 @@ enum Command {
         /// actuator forces, motor torques and potential energy, as JSON.
         #[arg(long, value_name = "FILE", conflicts_with_all = ["task", "series", "samples", "no_reactions"])]
         states: Option<PathBuf>,
+        #[command(flatten)]
+        jobs: Jobs,
     },
     /// The whole case study: unbalanced indicators, balance search, optimisation, ranking,
     /// reports (results.json, report.html, report.md, ranking.csv).
@@ -83,6 +96,16 @@ enum Command {
         /// Ranking resolution in percentage points: closer values tie.
         #[arg(long, default_value_t = 0.01)]
         resolution: f64,
+        /// Equivalence tolerance of the report's decision section, percentage points: variants
+        /// whose ΔQTR and ΔQIT are within it of the best-ranked one are compared by added
+        /// mass, ΔR, element count and spring force.
+        #[arg(long, default_value_t = counterpoise_report::decision::DEFAULT_TOLERANCE, value_name = "PP", value_parser = parse_points)]
+        tolerance: f64,
+        /// No progress on stderr (the summary still goes to stdout).
+        #[arg(long, short)]
+        quiet: bool,
+        #[command(flatten)]
+        jobs: Jobs,
     },
     /// Write a case file from a URDF robot description (bodies, joints, actuators, a default
     /// balancing section and task grid).
@@ -103,6 +126,10 @@ enum Command {
     Report {
         /// A directory written by `run`.
         dir: PathBuf,
+        /// Recompute the decision section at this equivalence tolerance (percentage points;
+        /// default: the one of the run).
+        #[arg(long, value_name = "PP", value_parser = parse_points)]
+        tolerance: Option<f64>,
     },
 }
 
@@ -145,8 +172,19 @@ fn quiet_broken_pipe() {
     }
 }
 
+/// The `--jobs` of the command, if it has one.
+fn jobs_of(command: &Command) -> Option<usize> {
+    match command {
+        Command::Check { jobs, .. }
+        | Command::Variants { jobs, .. }
+        | Command::Evaluate { jobs, .. }
+        | Command::Run { jobs, .. } => jobs.jobs,
+        Command::ImportUrdf { .. } | Command::Report { .. } => None,
+    }
+}
+
 fn run(cli: Cli) -> ExitCode {
-    if let Some(jobs) = cli.jobs {
+    if let Some(jobs) = jobs_of(&cli.command) {
         if jobs == 0 {
             eprintln!("error: --jobs must be at least 1");
             return ExitCode::from(2);
@@ -160,8 +198,10 @@ fn run(cli: Cli) -> ExitCode {
         }
     }
     let result = match cli.command {
-        Command::Check { case } => commands::check::run(&case),
-        Command::Variants { case, dmax, json } => commands::variants::run(&case, dmax, json),
+        Command::Check { case, .. } => commands::check::run(&case),
+        Command::Variants {
+            case, dmax, json, ..
+        } => commands::variants::run(&case, dmax, json),
         Command::Evaluate {
             case,
             states: Some(states),
@@ -175,6 +215,7 @@ fn run(cli: Cli) -> ExitCode {
             task,
             series,
             states: None,
+            ..
         } => commands::evaluate::run(
             &case,
             commands::evaluate::Options {
@@ -190,6 +231,9 @@ fn run(cli: Cli) -> ExitCode {
             out,
             minimax,
             resolution,
+            tolerance,
+            quiet,
+            ..
         } => commands::run::run(
             &case,
             commands::run::Options {
@@ -198,9 +242,11 @@ fn run(cli: Cli) -> ExitCode {
                 jobs: rayon::current_num_threads(),
                 minimax,
                 resolution,
+                tolerance,
+                progress: commands::progress::Progress::detect(quiet, 4),
             },
         ),
-        Command::Report { dir } => commands::report(&dir),
+        Command::Report { dir, tolerance } => commands::report(&dir, tolerance),
         Command::ImportUrdf {
             urdf,
             out,
@@ -221,10 +267,11 @@ fn run(cli: Cli) -> ExitCode {
     }
 }
 
-/// `I,J` → grid indices of a task.
+/// `I,J` (or `I→J`, as the reports write tasks, or `I->J`) → grid indices of a task.
 fn parse_task(text: &str) -> Result<(usize, usize), String> {
-    let (i, j) = text
-        .split_once(',')
+    let (i, j) = ["→", "->", ","]
+        .iter()
+        .find_map(|sep| text.split_once(sep))
         .ok_or_else(|| format!("expected I,J (two grid indices), found `{text}`"))?;
     let parse = |s: &str| {
         s.trim()
@@ -232,4 +279,14 @@ fn parse_task(text: &str) -> Result<(usize, usize), String> {
             .map_err(|_| format!("`{s}` is not a grid index"))
     };
     Ok((parse(i)?, parse(j)?))
+}
+
+/// Percentage points: a finite number ≥ 0.
+fn parse_points(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!(
+            "`{text}` is not a number of percentage points (finite, ≥ 0)"
+        )),
+    }
 }

@@ -70,8 +70,8 @@ fn variants_json_lists_every_variant_with_elements_and_status() {
 
 #[test]
 fn variants_are_identical_with_one_and_two_threads() {
-    let one = counterpoise(&["--jobs", "1", "variants", "cases/palletizer.json", "--json"]);
-    let two = counterpoise(&["--jobs", "2", "variants", "cases/palletizer.json", "--json"]);
+    let one = counterpoise(&["variants", "cases/palletizer.json", "--json", "--jobs", "1"]);
+    let two = counterpoise(&["variants", "cases/palletizer.json", "--json", "--jobs", "2"]);
     let strip = |o: &Output| {
         let mut doc: serde_json::Value = serde_json::from_str(&stdout(o)).unwrap();
         doc["seconds"] = serde_json::Value::Null;
@@ -279,7 +279,10 @@ fn usage_errors_exit_with_code_2() {
             "--series",
             "s.json",
         ],
-        &["--jobs", "0", "check", "cases/pendulum.json"],
+        &["check", "cases/pendulum.json", "--jobs", "0"],
+        // `report` and `import-urdf` have no parallel stage, so no --jobs
+        &["report", "out/pendulum", "--jobs", "2"],
+        &["run", "cases/pendulum.json", "--tolerance", "-1"],
         &["run", "cases/pendulum.json", "--resolution", "fine"],
     ] {
         let out = counterpoise(args);
@@ -340,4 +343,93 @@ fn check_names_the_path_of_the_balance_decision() {
     let text = stdout(&out);
     assert!(text.contains("balance decision: numeric"), "{text}");
     assert!(text.contains("bodies[0].pose[0].rot_y"), "{text}");
+}
+
+#[test]
+fn a_case_without_bounds_gets_bounds_from_the_mechanism() {
+    // The pendulum: one uniform rod, m = 2 kg, CoM at L/2 = 0.5 m, I = 0.1667 kg·m² about the
+    // CoM (m L²/12 with L = 1 m). Moving mass 2 kg; reach |c| + √3·√(I/m) = 0.5 + 0.5 = 1 m.
+    let check = counterpoise(&["check", "cases/pendulum.json"]);
+    assert_success(&check);
+    let text = stdout(&check);
+    assert!(
+        text.contains(
+            "bounds not in the case, derived from the mechanism (moving mass M = 2 kg, reach 1 m"
+        ),
+        "{text}"
+    );
+    assert!(text.contains("mass [0, 2] kg (the moving mass)"), "{text}");
+    let dir = tempfile::tempdir().unwrap();
+    let (o, doc) = run_pendulum(dir.path(), "out", &[]);
+    assert!(
+        stderr(&o).contains("note: bounds not in the case"),
+        "{}",
+        stderr(&o)
+    );
+    // Balance needs m·r = m_rod·L/2 = 1 kg·m. A heavier counterweight closer in adds less
+    // inertia (m r² = 1/m), so the optimiser takes the largest mass the bounds allow: 2 kg,
+    // hence r = 0.5 m, opposite the rod — not 1000 kg at 1 mm.
+    let m1 = feasible(&doc)
+        .into_iter()
+        .find(|v| v["elements"][0]["label"] == "m1")
+        .unwrap();
+    let cw = &m1["parameters"]["counterweights"][0];
+    assert!((num(cw, "mass") - 2.0).abs() < 1e-6, "{cw}");
+    assert!(
+        (cw["offset"][0].as_f64().unwrap() + 0.5).abs() < 1e-6,
+        "{cw}"
+    );
+    assert!((num(&m1["practical"], "added_mass_percent") - 100.0).abs() < 1e-4);
+    let notes = doc["metadata"]["notes"].as_array().unwrap();
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.as_str().unwrap().starts_with("Bounds not in the case"))
+    );
+}
+
+#[test]
+fn progress_is_one_line_per_phase_off_a_terminal_and_quiet_silences_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (o, _) = run_pendulum(dir.path(), "loud", &[]);
+    let lines: Vec<String> = stderr(&o)
+        .lines()
+        .filter(|l| l.starts_with('['))
+        .map(str::to_string)
+        .collect();
+    assert_eq!(lines.len(), 4, "{lines:?}");
+    assert!(lines[0].starts_with("[1/4] Phase 1: unbalanced robot over all tasks (elapsed "));
+    assert!(lines[3].starts_with("[4/4] Phase 3: ranking"), "{lines:?}");
+    let (o, _) = run_pendulum(dir.path(), "quiet", &["--quiet"]);
+    assert_eq!(stderr(&o), "");
+    assert!(stdout(&o).contains("wrote "));
+}
+
+#[test]
+fn report_of_a_missing_directory_says_so_once() {
+    let out = counterpoise(&["report", "no-such-directory"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: no-such-directory/results.json: "),
+        "{err}"
+    );
+    assert_eq!(err.matches("os error 2").count(), 1, "{err}");
+}
+
+#[test]
+fn report_recomputes_the_recommendation_at_another_tolerance() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, doc) = run_pendulum(dir.path(), "out", &["--tolerance", "0.5"]);
+    assert_eq!(doc["decision"]["tolerance"], serde_json::json!(0.5));
+    let out = dir.path().join("out");
+    let o = counterpoise(&["report", out.to_str().unwrap(), "--tolerance", "80"]);
+    assert_success(&o);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    // at 80 pp both pendulum variants are equivalent: the overall line counts two
+    assert!(
+        md.contains("Of the 2 variants within 80 percentage points"),
+        "{md}"
+    );
 }

@@ -92,6 +92,16 @@ fn best_variant_of_each_class_matches_the_readme() {
         out.to_str().unwrap(),
     ]);
     assert_success(&run);
+    // The README's recommendation line is the one the run prints.
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let printed = |text: &str| {
+        text.lines()
+            .find(|l| l.starts_with("Recommended: "))
+            .map(str::to_string)
+    };
+    let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
+    assert!(printed(&stdout).is_some(), "{stdout}");
+    assert_eq!(printed(&readme), printed(&stdout));
     let doc = results(&out);
     for row in &expected {
         let best = doc["variants"]

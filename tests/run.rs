@@ -45,7 +45,9 @@ fn run_writes_every_output_and_report_regenerates_them() {
         );
     }
     let results = results(&out);
-    assert_eq!(results["schema_version"], 1);
+    assert_eq!(results["schema_version"], 2);
+    // docs/palletizer.md: 1990 kg in all with the 800 kg base, which does not move
+    assert_eq!(results["moving_mass"], serde_json::json!(1188.625));
     let variants = results["variants"].as_array().unwrap();
     assert_eq!(variants.len(), 406, "paper Eq. A8");
     let counted: u64 = results["counts"]
@@ -96,7 +98,56 @@ fn run_writes_every_output_and_report_regenerates_them() {
         );
         // balanced: the motor torque is inertial only, below the unbalanced robot's
         assert!(num(v, "dqtr") < 0.0);
+        // Practical figures from the parameters: masses add, a zero-free-length spring's
+        // force is K times its stretch, shares are of the moving mass.
+        let p = &v["practical"];
+        let params = &v["parameters"];
+        let masses: f64 = params["counterweights"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| num(c, "mass"))
+            .sum();
+        assert!((num(p, "added_mass") - masses).abs() < 1e-9, "{p}");
+        assert!((num(p, "added_mass_percent") - masses / 1188.625 * 100.0).abs() < 1e-9);
+        assert_eq!(
+            p["elements"].as_u64().unwrap() as usize,
+            v["elements"].as_array().unwrap().len()
+        );
+        let springs = params["springs"].as_array().unwrap();
+        let peaks = p["springs"].as_array().cloned().unwrap_or_default();
+        for (s, peak) in springs.iter().zip(&peaks) {
+            assert_eq!(s["label"], peak["label"]);
+            let expected = num(s, "stiffness") * num(peak, "elongation");
+            assert!(
+                (num(peak, "force") - expected).abs() < 1e-9 * expected,
+                "{peak}"
+            );
+            // the anchors' distance can never exceed |a| + |b| plus the body origins' spread
+            // (2 m on this robot), nor be negative
+            assert!(num(peak, "elongation") > 0.0 && num(peak, "elongation") < 10.0);
+        }
+        assert_eq!(
+            p["springs"].as_array().map_or(0, |a| a.len()),
+            springs.len()
+        );
     }
+    assert!(
+        results["spring_peaks_basis"]
+            .as_str()
+            .unwrap()
+            .contains("27 task-grid points")
+    );
+    // The decision: an overall pick among the variants equivalent to rank 1.
+    let overall = &results["decision"]["overall"];
+    let rank1 = feasible.iter().find(|v| v["rank"] == 1).unwrap();
+    assert_eq!(overall["leader"], rank1["id"]);
+    let chosen = feasible
+        .iter()
+        .find(|v| v["id"] == overall["chosen"])
+        .unwrap();
+    assert!(num(chosen, "dqtr") <= num(rank1, "dqtr") + 0.5);
+    assert!(num(chosen, "dqit") <= num(rank1, "dqit") + 0.5);
     for v in &springs {
         assert!(
             (num(v, "dqtr") - spring_dqtr).abs() < 1e-6,
@@ -205,8 +256,8 @@ fn run_is_identical_with_one_and_two_threads_and_resolution_decides_ties() {
         }
         doc
     };
-    let (one, one_csv) = run("one", &["--jobs", "1"], &[]);
-    let (two, two_csv) = run("two", &["--jobs", "2"], &[]);
+    let (one, one_csv) = run("one", &[], &["--jobs", "1"]);
+    let (two, two_csv) = run("two", &[], &["--jobs", "2"]);
     let one = strip(one, 1);
     assert_eq!(one, strip(two, 2));
     assert_eq!(one_csv, two_csv);

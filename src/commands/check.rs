@@ -224,6 +224,9 @@ pub fn summary(model: &Model) -> String {
             Err(e) => format!("numeric, with an ambiguous zone reported as undecided ({e})"),
         };
         line(&mut out, format!("balance decision: {decision}"));
+        if let Some(note) = super::derived_bounds_note(model) {
+            line(&mut out, note);
+        }
     }
     out
 }

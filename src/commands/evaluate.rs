@@ -31,7 +31,7 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     }
     if let Some(((i, j), file)) = options.series {
         let series =
-            task_series(&model, i, j, options.samples).with_context(|| format!("task {i},{j}"))?;
+            task_series(&model, i, j, options.samples).with_context(|| format!("task {i}→{j}"))?;
         let text = serde_json::to_string_pretty(&series)?;
         super::write_atomic(file, text.as_bytes())?;
         eprintln!("wrote the series of task {i}→{j} to {}", file.display());
@@ -55,6 +55,11 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// A task as every view writes it: `from→to`.
+fn task(t: [usize; 2]) -> String {
+    counterpoise_report::format::task(t)
+}
+
 fn summary(r: &EvaluationReport, seconds: f64) -> String {
     let ind = &r.indicators;
     let mut out = format!(
@@ -68,8 +73,11 @@ fn summary(r: &EvaluationReport, seconds: f64) -> String {
         ));
     }
     out.push_str(&format!(
-        "QTR = {:.3} N·m (task {:?})   QIT = {:.3} N·m (task {:?})\n\n",
-        ind.qtr, ind.qtr_task, ind.qit, ind.qit_task
+        "QTR = {:.3} N·m (task {})   QIT = {:.3} N·m (task {})\n\n",
+        ind.qtr,
+        task(ind.qtr_task),
+        ind.qit,
+        task(ind.qit_task)
     ));
     out.push_str(&format!(
         "{:<8} {:>12} {:>12} {:>12} {:>12}\n",
@@ -80,9 +88,9 @@ fn summary(r: &EvaluationReport, seconds: f64) -> String {
             "{:<8} {:>12.3} {:>12} {:>12.3} {:>12}\n",
             a.name,
             a.crt_rms,
-            format!("{},{}", a.crt[0], a.crt[1]),
+            task(a.crt),
             a.cpt_peak,
-            format!("{},{}", a.cpt[0], a.cpt[1])
+            task(a.cpt)
         ));
     }
     if !ind.joints.is_empty() {

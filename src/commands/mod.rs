@@ -3,6 +3,7 @@
 pub mod check;
 pub mod evaluate;
 pub mod import_urdf;
+pub mod progress;
 pub mod run;
 pub mod states;
 pub mod variants;
@@ -60,9 +61,10 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
     Ok(())
 }
 
-/// `counterpoise report DIR`: rewrites the reports from `DIR/results.json`.
-pub fn report(dir: &Path) -> Result<std::process::ExitCode> {
-    let written = counterpoise_report::regenerate(dir)?;
+/// `counterpoise report DIR`: rewrites the reports from `DIR/results.json`, with the decision
+/// recomputed at `tolerance` when one is given.
+pub fn report(dir: &Path, tolerance: Option<f64>) -> Result<std::process::ExitCode> {
+    let written = counterpoise_report::regenerate_with(dir, tolerance)?;
     for f in written {
         println!("wrote {}", f.display());
     }
@@ -88,4 +90,36 @@ pub fn before_run(path: &std::path::Path, model: &Model, dmax_given: bool, dmax:
     }
     print_errors(path, &located(path, problems));
     false
+}
+
+/// `bounds derived from the mechanism (…)`, naming each bound the case left out, its value and
+/// what it comes from; `None` when the case sets them all.
+pub fn derived_bounds_note(model: &Model) -> Option<String> {
+    let b = model.balancing.as_ref()?;
+    if b.derived_bounds.is_empty() {
+        return None;
+    }
+    let scale = counterpoise_model::MechanismScale::of(&model.bodies, model.gravity);
+    let g = counterpoise_report::format::compact;
+    let parts: Vec<String> = b
+        .derived_bounds
+        .iter()
+        .map(|name| {
+            let (range, unit, from) = match *name {
+                "mass" => (b.bounds.mass, "kg", "the moving mass"),
+                "radius" => (b.bounds.radius, "m", "the reach"),
+                "stiffness" => (b.bounds.stiffness, "N/m", "100·M·|g|/reach"),
+                "anchor_a" => (b.bounds.anchor_a, "m", "the reach"),
+                _ => (b.bounds.anchor_b, "m", "the reach"),
+            };
+            format!("{name} [{}, {}] {unit} ({from})", g(range[0]), g(range[1]))
+        })
+        .collect();
+    Some(format!(
+        "bounds not in the case, derived from the mechanism (moving mass M = {} kg, reach {} m; \
+         docs/case-format.md): {}",
+        g(scale.moving_mass),
+        g(scale.reach),
+        parts.join(", ")
+    ))
 }

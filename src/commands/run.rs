@@ -17,7 +17,6 @@ use counterpoise_dynamics::{
 use counterpoise_model::Model;
 use counterpoise_optimise::{Context, Objective, OptimiseOptions, OptimisedVariant, optimise_all};
 use counterpoise_report as report;
-use indicatif::{ProgressBar, ProgressStyle};
 use report::{
     ActuatorSummary, ElementInfo, ElementKind, Evaluation, FreeDirection, JointPeak, OptimiserInfo,
     PhaseTiming, PhysicalParameters, RankingOptions, RunMetadata, RunResults, VariantRecord,
@@ -31,27 +30,25 @@ pub struct Options {
     pub jobs: usize,
     pub minimax: bool,
     pub resolution: f64,
+    /// Tolerance of the decision section's equivalence, percentage points.
+    pub tolerance: f64,
+    /// How progress is shown on stderr.
+    pub progress: super::progress::Progress,
 }
 
-/// A spinner for one phase on stderr; indicatif hides it when stderr is not a terminal.
-fn phase(message: &str) -> ProgressBar {
-    let bar = ProgressBar::new_spinner();
-    bar.set_style(ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("template"));
-    bar.set_message(message.to_string());
-    bar.enable_steady_tick(std::time::Duration::from_millis(120));
-    bar
+struct Timer {
+    timings: Vec<PhaseTiming>,
+    progress: super::progress::Progress,
 }
-
-struct Timer(Vec<PhaseTiming>);
 
 impl Timer {
     fn time<T>(&mut self, name: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
-        let bar = phase(name);
+        let phase = self.progress.phase(name);
         let started = Instant::now();
         let out = work();
         let seconds = started.elapsed().as_secs_f64();
-        bar.finish_and_clear();
-        self.0.push(PhaseTiming {
+        phase.finish();
+        self.timings.push(PhaseTiming {
             phase: name.to_string(),
             seconds,
         });
@@ -76,13 +73,22 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     if !super::before_run(path, &model, options.dmax.is_some(), dmax) {
         return Ok(ExitCode::FAILURE);
     }
+    if let (Some(note), false) = (
+        super::derived_bounds_note(&model),
+        options.progress.mode == super::progress::Mode::Quiet,
+    ) {
+        eprintln!("note: {note}");
+    }
     let out_dir = options
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&model.name));
     std::fs::create_dir_all(&out_dir)
         .with_context(|| format!("cannot create the output directory {}", out_dir.display()))?;
-    let mut timer = Timer(Vec::new());
+    let mut timer = Timer {
+        timings: Vec::new(),
+        progress: options.progress,
+    };
 
     // Phase 1: the unbalanced robot over every task, with joint reactions.
     let (unbalanced, ub_grid_info) =
@@ -118,7 +124,13 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     })?;
 
     // Phase 2: optimisation of every balanced variant, re-evaluated over all tasks.
-    let optimised = timer.time("Phase 2: optimisation of the balanced variants", || {
+    let balanced_count = found
+        .variants
+        .iter()
+        .filter(|v| v.status == Status::Balanced)
+        .count();
+    let phase_name = format!("Phase 2: optimisation of the {balanced_count} balanced variants");
+    let optimised = timer.time(&phase_name, || {
         let context = Context::new(&model, Some(unbalanced.clone()))?;
         let settings = OptimiseOptions {
             objective: if options.minimax {
@@ -147,6 +159,12 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
         serde_json::to_value(&model.case)?,
         evaluation(&unbalanced, ub_grid_info),
     );
+    if let Some(note) = super::derived_bounds_note(&model) {
+        results
+            .metadata
+            .notes
+            .push(format!("{}.", capitalised(&note)));
+    }
     if ub_grid_info.2 {
         results.metadata.notes.push(
             "The mechanism is overconstrained (planar loops in space): joint reactions are the \
@@ -165,26 +183,39 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
             .variants
             .push(record(&model, id, v, opt, ub_grid_info));
     }
+    results.moving_mass = Some(model.bodies.iter().map(|b| b.mass).sum());
     timer.time("Phase 3: ranking, torque curves, path", || {
         let ranking = RankingOptions {
             resolution: options.resolution,
+            tolerance: options.tolerance,
         };
         results.finalize(&ranking)?;
         let mechanisms = best_mechanisms(&model, &results, &optimised)?;
         add_torque_charts(&model, &mut results, &mechanisms)?;
+        let mut path_configurations = Vec::new();
         if !model.paths.is_empty() {
-            results.path = Some(path_simulation(&model, &mechanisms, 0)?);
+            let (simulation, q) = path_simulation(&model, &mechanisms, 0)?;
+            results.path = Some(simulation);
+            path_configurations = q;
         }
+        add_practical_figures(&model, &mut results, path_configurations)?;
         results.finalize(&ranking)?;
         Ok(())
     })?;
-    results.metadata.timings = timer.0;
+    results.metadata.timings = timer.timings;
     let written = report::write_outputs(&out_dir, &results)?;
     print!("{}", report::text::summary(&results));
     for f in written {
         println!("wrote {}", f.display());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+fn capitalised(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
 }
 
 fn utc_now() -> String {
@@ -468,10 +499,15 @@ const STATIC_STRETCH: f64 = 1e6;
 
 /// The paper's Sec. 3.3 simulation along path `index`: the timed cycle, and the same path
 /// traversed quasi-statically (static torques).
-fn path_simulation(model: &Model, m: &Mechanisms, index: usize) -> Result<report::PathSimulation> {
+fn path_simulation(
+    model: &Model,
+    m: &Mechanisms,
+    index: usize,
+) -> Result<(report::PathSimulation, Vec<Vec<f64>>)> {
     let spec = &model.paths[index];
     let actuators: Vec<String> = model.actuators.iter().map(|a| a.name.clone()).collect();
-    let run_of = |model: &Model, time_scale: f64| -> Result<report::PathRun> {
+    let mut configurations: Vec<Vec<f64>> = Vec::new();
+    let mut run_of = |model: &Model, time_scale: f64| -> Result<report::PathRun> {
         let mut x = Vec::new();
         let mut mechanisms = Vec::new();
         for (column, (label, variant)) in m.labels.iter().enumerate() {
@@ -484,6 +520,9 @@ fn path_simulation(model: &Model, m: &Mechanisms, index: usize) -> Result<report
             )?;
             if x.is_empty() {
                 x = series.t.iter().map(|t| t / time_scale).collect();
+                if configurations.is_empty() {
+                    configurations = series.q.clone();
+                }
             }
             let torques = (0..actuators.len())
                 .map(|k| series.motor_torque.iter().map(|row| row[k]).collect())
@@ -524,7 +563,7 @@ fn path_simulation(model: &Model, m: &Mechanisms, index: usize) -> Result<report
             )
         })
         .unwrap_or_default();
-    Ok(report::PathSimulation {
+    let simulation = report::PathSimulation {
         name: spec.name.clone(),
         description: Some(format!(
             "{waypoints} in {:.2} s{payload}; static torques from the same path traversed \
@@ -535,7 +574,90 @@ fn path_simulation(model: &Model, m: &Mechanisms, index: usize) -> Result<report
         static_run: Some(static_run),
         dynamic_run: Some(dynamic_run),
         table: Vec::new(),
-    })
+    };
+    Ok((simulation, configurations))
+}
+
+/// Configurations at every task-grid point (where each task starts and ends), solved as the
+/// dynamics solves them; points whose kinematics fail are left out (they are excluded tasks).
+fn grid_configurations(model: &Model) -> Result<Vec<Vec<f64>>> {
+    let Some(spec) = &model.tasks else {
+        return Ok(Vec::new());
+    };
+    let ev = counterpoise_dynamics::Evaluator::new(model)?;
+    Ok(spec
+        .grid_points()
+        .iter()
+        .filter_map(|u| ev.solve_point(u).ok())
+        .collect())
+}
+
+/// Length of a spring (the distance of its anchors, world frame) at configuration `q`.
+fn spring_length(
+    model: &Model,
+    kinematics: &counterpoise_model::Kinematics,
+    s: &report::SpringParams,
+    q: &nalgebra::DVector<f64>,
+) -> Option<f64> {
+    let point = |body: &str, anchor: [f64; 3]| -> Option<nalgebra::Vector3<f64>> {
+        let a = nalgebra::Vector3::from(anchor);
+        if body == "base" {
+            return Some(a);
+        }
+        let pose = kinematics.body_pose(model.body_index(body)?, q);
+        Some(pose.position + pose.rotation * a)
+    };
+    Some((point(&s.body, s.anchor_a)? - point(&s.other, s.anchor_b)?).norm())
+}
+
+/// The practical figures of every feasible variant (added mass, elements, peak offset, peak
+/// spring force and stretch). The spring peaks are the largest anchor distances over the
+/// task-grid points and the samples of the path simulation: the configurations the mechanism
+/// rests in and the one cycle simulated in full. A move between two grid points can pass
+/// through a longer stretch; that is the documented limit of the figure.
+fn add_practical_figures(
+    model: &Model,
+    results: &mut RunResults,
+    path_configurations: Vec<Vec<f64>>,
+) -> Result<()> {
+    let grid = grid_configurations(model)?;
+    let (grid_n, path_n) = (grid.len(), path_configurations.len());
+    let configurations: Vec<nalgebra::DVector<f64>> = grid
+        .into_iter()
+        .chain(path_configurations)
+        .map(nalgebra::DVector::from_vec)
+        .collect();
+    let kinematics = counterpoise_model::Kinematics::new(model);
+    let moving_mass = results.moving_mass;
+    for v in results.variants.iter_mut() {
+        if v.status != VariantStatus::Feasible {
+            continue;
+        }
+        let Some(p) = &v.parameters else { continue };
+        let peaks = p
+            .springs
+            .iter()
+            .map(|s| {
+                report::SpringPeak::from_lengths(
+                    &s.label,
+                    s.stiffness,
+                    configurations
+                        .iter()
+                        .filter_map(|q| spring_length(model, &kinematics, s, q)),
+                )
+            })
+            .collect();
+        v.practical = Some(report::PracticalFigures::new(p, moving_mass, peaks));
+    }
+    results.spring_peaks_basis = Some(if path_n > 0 {
+        format!(
+            "the largest over the {grid_n} task-grid points (where every task starts and ends) \
+             and the {path_n} samples of the path simulation"
+        )
+    } else {
+        format!("the largest over the {grid_n} task-grid points (where every task starts and ends)")
+    });
+    Ok(())
 }
 
 /// Torque curves (paper Fig. 10-style) of the unbalanced robot and the best variant of each

@@ -220,8 +220,8 @@ pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -
     {
         let labels: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
         out.push_str(&format!(
-            "{{{}}}  {}  free parameters: {}  verification residual {:.1e}\n",
-            labels.join(", "),
+            "{}  {}  free parameters: {}  verification residual {:.1e}\n",
+            labels.join(" + "),
             v.class.name(),
             v.nullity,
             v.verification.map_or(f64::NAN, |x| x.residual)
@@ -255,8 +255,8 @@ pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -
         for v in degenerate {
             let labels: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
             out.push_str(&format!(
-                "{{{}}}  idle: {}\n",
-                labels.join(", "),
+                "{}  idle: {}\n",
+                labels.join(" + "),
                 v.idle.join(", ")
             ));
         }
@@ -271,8 +271,8 @@ pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -
         for v in others {
             let labels: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
             out.push_str(&format!(
-                "{{{}}}  {}: {}\n",
-                labels.join(", "),
+                "{}  {}: {}\n",
+                labels.join(" + "),
                 v.status.name(),
                 v.reason.as_deref().unwrap_or("")
             ));

@@ -33,8 +33,8 @@ pub use kinematics::{BodyJacobian, BodyMotion, Kinematics, Pose};
 pub use limits::{Limit, Limits};
 pub use model::{
     Actuator, ActuatorMap, Balancing, Body, BodyId, Bounds, Coordinate, CounterweightOptions,
-    CounterweightShape, GridAxis, Joint, JointKind, Model, MotionLaw, PairMode, PathPayload,
-    Payload, PayloadMode, Plane, SpringOptions, TaskPath, Tasks, Waypoint,
+    CounterweightShape, GridAxis, Joint, JointKind, MechanismScale, Model, MotionLaw, PairMode,
+    PathPayload, Payload, PayloadMode, Plane, SpringOptions, TaskPath, Tasks, Waypoint,
 };
 pub use newton::{KinematicsError, NewtonOptions};
 

@@ -286,6 +286,80 @@ impl Default for Bounds {
     }
 }
 
+/// What the default bounds are derived from: the mechanism's moving mass and reach.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MechanismScale {
+    /// Sum of the bodies' masses (every body moves), kg.
+    pub moving_mass: f64,
+    /// Largest body reach, m: for each body, the distance of its centre of mass from its frame
+    /// origin plus √3 times its largest radius of gyration about the centre of mass (a uniform
+    /// rod of length ℓ has k = ℓ/√12, so √3·k = ℓ/2: the reach of a rod hung at one end is its
+    /// length).
+    pub reach: f64,
+    /// |g|, m/s².
+    pub gravity: f64,
+}
+
+impl MechanismScale {
+    /// The scale of `bodies` under `gravity`.
+    pub fn of(bodies: &[Body], gravity: Vector3<f64>) -> MechanismScale {
+        let reach = bodies
+            .iter()
+            .map(|b| {
+                let k = if b.mass > 0.0 {
+                    let largest = b
+                        .inertia_com
+                        .symmetric_eigenvalues()
+                        .iter()
+                        .fold(0.0f64, |m, x| m.max(*x));
+                    (largest / b.mass).max(0.0).sqrt()
+                } else {
+                    0.0
+                };
+                b.com.norm() + 3f64.sqrt() * k
+            })
+            .fold(0.0f64, f64::max);
+        MechanismScale {
+            moving_mass: bodies.iter().map(|b| b.mass).sum(),
+            reach,
+            gravity: gravity.norm(),
+        }
+    }
+}
+
+impl Bounds {
+    /// Default bounds derived from the mechanism (docs/case-format.md, `bounds`): counterweight
+    /// mass up to the moving mass, offsets and anchor distances up to the reach, stiffness up
+    /// to the value whose force at 1 % of the reach carries the whole moving weight
+    /// (`100·M·|g|/reach`). A scale that is zero (no mass, no extent, no gravity) keeps the
+    /// fixed default of [`Bounds::default`] for that entry.
+    pub fn derived(scale: &MechanismScale) -> Bounds {
+        let fixed = Bounds::default();
+        let pick = |v: f64, fallback: [f64; 2]| {
+            if v.is_finite() && v > 0.0 {
+                [0.0, v]
+            } else {
+                fallback
+            }
+        };
+        let length = |fallback| pick(scale.reach, fallback);
+        Bounds {
+            mass: pick(scale.moving_mass, fixed.mass),
+            radius: length(fixed.radius),
+            stiffness: if scale.reach > 0.0 {
+                pick(
+                    100.0 * scale.moving_mass * scale.gravity / scale.reach,
+                    fixed.stiffness,
+                )
+            } else {
+                fixed.stiffness
+            },
+            anchor_a: length(fixed.anchor_a),
+            anchor_b: length(fixed.anchor_b),
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Balancing {
     /// Most elements per variant (≥ 1).
@@ -293,6 +367,9 @@ pub struct Balancing {
     pub counterweights: Option<CounterweightOptions>,
     pub springs: Option<SpringOptions>,
     pub bounds: Bounds,
+    /// Which `bounds` entries the case left out and were derived from the mechanism
+    /// ([`Bounds::derived`]), e.g. `["mass", "radius"]`; `check` and `run` name them.
+    pub derived_bounds: Vec<&'static str>,
     /// Peak motor torque limit per actuator (index = actuator), N·m.
     pub peak_limits: Vec<Option<f64>>,
     /// Raw, not yet interpreted (a later issue defines them).

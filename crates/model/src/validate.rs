@@ -18,8 +18,8 @@ use crate::joints::{self, JointInput};
 use crate::limits::{Limit, Limits, MAX_POSE_DEGREE};
 use crate::model::{
     Actuator, ActuatorMap, Balancing, Body, BodyId, Bounds, Coordinate, CounterweightOptions,
-    CounterweightShape, GridAxis, Joint, JointKind, Model, MotionLaw, PairMode, PathPayload,
-    Payload, Plane, SpringOptions, TaskPath, Tasks, Waypoint,
+    CounterweightShape, GridAxis, Joint, JointKind, MechanismScale, Model, MotionLaw, PairMode,
+    PathPayload, Payload, Plane, SpringOptions, TaskPath, Tasks, Waypoint,
 };
 use crate::pose::{Parser, PolyPose};
 use crate::reader::too_large;
@@ -642,7 +642,23 @@ pub fn validate_with(case: Case, limits: &Limits) -> Result<Model, CaseErrors> {
                 origin: pose.origin,
             }
         })
-        .collect();
+        .collect::<Vec<Body>>();
+    let mut balancing = balancing;
+    if let Some(b) = &mut balancing {
+        // The entries the case left out: derived from the mechanism, not fixed numbers (a
+        // 1000 kg counterweight on a 2 kg rod is the optimiser's answer to a bound nobody set).
+        let derived = Bounds::derived(&MechanismScale::of(&bodies, Vector3::from(case.gravity)));
+        for name in &b.derived_bounds {
+            match *name {
+                "mass" => b.bounds.mass = derived.mass,
+                "radius" => b.bounds.radius = derived.radius,
+                "stiffness" => b.bounds.stiffness = derived.stiffness,
+                "anchor_a" => b.bounds.anchor_a = derived.anchor_a,
+                "anchor_b" => b.bounds.anchor_b = derived.anchor_b,
+                _ => {}
+            }
+        }
+    }
     Ok(Model {
         name: case.name.clone(),
         description: case.description.clone(),
@@ -1141,6 +1157,17 @@ fn balancing(
         counterweights,
         springs,
         bounds,
+        derived_bounds: [
+            ("mass", spec.mass),
+            ("radius", spec.radius),
+            ("stiffness", spec.stiffness),
+            ("anchor_a", spec.anchor_a),
+            ("anchor_b", spec.anchor_b),
+        ]
+        .iter()
+        .filter(|(_, given)| given.is_none())
+        .map(|(name, _)| *name)
+        .collect(),
         peak_limits,
         overrides: b.overrides.clone(),
     })

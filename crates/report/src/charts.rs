@@ -3,8 +3,11 @@
 //! Shared by the HTML writer and the tests that count one `<svg>` per chart.
 
 use crate::ranking::Class;
-use crate::results::{PathRun, RunResults};
-use crate::svg::{BarChart, LineChart, LineSeries, PALETTE, bar_chart, line_chart};
+use crate::results::{PathRun, RunResults, VariantRecord};
+use crate::svg::{
+    BarChart, DASHES, LineChart, LineSeries, Marker, PALETTE, ScatterChart, ScatterPoint,
+    bar_chart, line_chart, scatter_chart,
+};
 
 /// A rendered chart and the section it belongs to.
 #[derive(Clone, Debug)]
@@ -16,6 +19,7 @@ pub struct Chart {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Section {
+    Decision,
     Ranking,
     Torque,
     PathStatic,
@@ -32,14 +36,28 @@ pub fn class_color(class: Option<Class>) -> &'static str {
     }
 }
 
+/// Marker of a class in every chart (the unbalanced robot has none).
+pub fn class_marker(class: Option<Class>) -> Option<Marker> {
+    match class {
+        None => None,
+        Some(Class::Counterweights) => Some(Marker::Circle),
+        Some(Class::Springs) => Some(Marker::Square),
+        Some(Class::Hybrid) => Some(Marker::Triangle),
+    }
+}
+
 /// Variants per bar chart: 16 groups fit the page width without shrinking the text.
 pub const BARS_PER_CHART: usize = 16;
 /// Most variants of one class shown as bars (the ranking table lists all of them).
 pub const MAX_BARS: usize = 48;
+/// A class with fewer ranked variants than this shares its bar chart with the other small
+/// classes (a chart of one bar compares nothing).
+pub const MIN_BARS: usize = 3;
 
 /// Every chart of the report, in display order.
 pub fn all(r: &RunResults) -> Vec<Chart> {
-    let mut charts = ranking_bars(r);
+    let mut charts: Vec<Chart> = pareto(r).into_iter().collect();
+    charts.extend(ranking_bars(r));
     charts.extend(torque(r));
     if let Some(p) = &r.path {
         if let Some(run) = &p.static_run {
@@ -66,41 +84,130 @@ pub fn all(r: &RunResults) -> Vec<Chart> {
     charts
 }
 
+/// Bars beyond this are clipped: twice the largest |ΔQTR| or |ΔQIT| of the ranked variants, at
+/// least 10 percentage points, rounded up to a multiple of 10, so an outlier ΔR (+21768 % on the pendulum) cannot flatten the
+/// motor indicators.
+pub fn bar_clip(r: &RunResults) -> f64 {
+    let motor = r
+        .ranked()
+        .iter()
+        .flat_map(|v| [v.dqtr, v.dqit])
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    // Rounded up to a multiple of 10, so the note reads "beyond ±70", not "±64.19".
+    ((2.0 * motor).max(10.0) / 10.0).ceil() * 10.0
+}
+
+/// `chunks` of about equal size (33 → 11, 11, 11, never 16, 16, 1).
+fn even_chunks<T: Copy>(items: &[T], most: usize) -> Vec<Vec<T>> {
+    if items.is_empty() {
+        return Vec::new();
+    }
+    let n = items.len().div_ceil(most);
+    let size = items.len().div_ceil(n);
+    items.chunks(size).map(|c| c.to_vec()).collect()
+}
+
+fn short_class(c: Class) -> &'static str {
+    match c {
+        Class::Counterweights => "cw",
+        Class::Springs => "springs",
+        Class::Hybrid => "hybrid",
+    }
+}
+
 /// Fig. 7: ΔQTR, ΔQIT, ΔR of each variant of a class, best on the left; long classes are
-/// split into charts of [`BARS_PER_CHART`] variants.
+/// split into charts of at most [`BARS_PER_CHART`] variants of about equal size, classes with
+/// fewer than [`MIN_BARS`] variants share one chart, and a lone leftover variant joins the
+/// smallest chart: no chart holds a single bar (unless only one variant is ranked at all, when
+/// there is no chart: the table says it all).
 fn ranking_bars(r: &RunResults) -> Vec<Chart> {
     let ranked = r.ranked();
-    let mut charts = Vec::new();
+    if ranked.len() < 2 {
+        return Vec::new();
+    }
+    // (title, variants, mixed classes)
+    let mut groups: Vec<(String, Vec<&VariantRecord>, bool)> = Vec::new();
+    let mut small: Vec<&VariantRecord> = Vec::new();
     for class in Class::ALL {
-        let mut vs: Vec<_> = ranked.iter().filter(|v| v.class == class).collect();
+        let mut vs: Vec<&VariantRecord> = ranked
+            .iter()
+            .copied()
+            .filter(|v| v.class == class)
+            .collect();
         vs.sort_by_key(|v| v.class_rank);
         let total = vs.len();
+        if total < MIN_BARS {
+            small.extend(vs);
+            continue;
+        }
         vs.truncate(MAX_BARS);
-        let chunks = vs.len().div_ceil(BARS_PER_CHART);
-        for (k, chunk) in vs.chunks(BARS_PER_CHART).enumerate() {
-            let title = if chunks == 1 && total == vs.len() {
+        let chunks = even_chunks(&vs, BARS_PER_CHART);
+        let single = chunks.len() == 1 && total == vs.len();
+        let mut first = 1;
+        for chunk in chunks {
+            let title = if single {
                 format!("{} — ranking indicators", class.title())
             } else {
-                let first = k * BARS_PER_CHART + 1;
                 format!(
                     "{} — class ranks {first}–{} of {total}",
                     class.title(),
                     first + chunk.len() - 1
                 )
             };
+            first += chunk.len();
+            groups.push((title, chunk, false));
+        }
+    }
+    let small_title = |vs: &[&VariantRecord]| {
+        Class::ALL
+            .iter()
+            .filter(|c| vs.iter().any(|v| v.class == **c))
+            .map(|c| c.title())
+            .collect::<Vec<_>>()
+            .join(" and ")
+    };
+    match small.len() {
+        0 => {}
+        1 if !groups.is_empty() => {
+            let k = (0..groups.len())
+                .min_by_key(|&k| groups[k].1.len())
+                .unwrap_or(0);
+            let g = &mut groups[k];
+            g.0 = format!("{}, with {}", g.0, small_title(&small));
+            g.1.push(small[0]);
+            g.2 = true;
+        }
+        _ => {
+            small.sort_by_key(|v| v.rank);
+            let title = format!("{} — ranking indicators", small_title(&small));
+            groups.push((title, small, true));
+        }
+    }
+    let clip = bar_clip(r);
+    groups
+        .into_iter()
+        .map(|(title, vs, mixed)| {
             let chart = BarChart {
                 title: title.clone(),
                 y_label: "variation vs unbalanced [%]".into(),
-                categories: chunk
+                categories: vs
                     .iter()
-                    .map(|v| (v.name.clone().unwrap_or_default(), v.label()))
+                    .map(|v| {
+                        let sub = if mixed {
+                            format!("{} ({})", v.label(), short_class(v.class))
+                        } else {
+                            v.label()
+                        };
+                        (v.name.clone().unwrap_or_default(), sub)
+                    })
                     .collect(),
                 series: vec![
                     ("ΔQTR (total RMS torque)".into(), "#0072B2".into()),
                     ("ΔQIT (total peak torque)".into(), "#56B4E9".into()),
                     ("ΔR (joint reactions)".into(), "#E69F00".into()),
                 ],
-                values: chunk
+                values: vs
                     .iter()
                     .map(|v| {
                         vec![
@@ -110,25 +217,159 @@ fn ranking_bars(r: &RunResults) -> Vec<Chart> {
                         ]
                     })
                     .collect(),
+                clip: Some(clip),
                 min_width: 560.0,
                 height: 340.0,
             };
-            charts.push(Chart {
+            Chart {
                 section: Section::Ranking,
                 title,
                 svg: bar_chart(&chart),
-            });
+            }
+        })
+        .collect()
+}
+
+/// The Pareto view of the decision: ΔQTR against added mass, ΔR as the marker size, class as
+/// colour and shape, the equivalence band, the non-dominated front and the recommendations.
+fn pareto(r: &RunResults) -> Option<Chart> {
+    let ranked = r.ranked();
+    let leader = ranked.first()?;
+    let decision = r.decision.as_ref()?;
+    let mass = |v: &VariantRecord| v.practical.as_ref().map_or(0.0, |p| p.added_mass);
+    let clip = bar_clip(r);
+    let size_max = ranked
+        .iter()
+        .filter_map(|v| v.dr)
+        .fold(0.0f64, f64::max)
+        .min(clip);
+    let mut callouts: Vec<(usize, Vec<String>)> = Vec::new();
+    for rec in decision.overall.iter().chain(&decision.classes) {
+        let scope = match rec.class {
+            None => "overall".to_string(),
+            Some(c) => c.name().to_string(),
+        };
+        match callouts.iter_mut().find(|(id, _)| *id == rec.chosen) {
+            Some((_, s)) => s.push(scope),
+            None => callouts.push((rec.chosen, vec![scope])),
         }
     }
-    charts
+    let points: Vec<ScatterPoint> = ranked
+        .iter()
+        .map(|v| {
+            let name = v.name.clone().unwrap_or_default();
+            ScatterPoint {
+                x: mass(v),
+                y: v.dqtr.unwrap_or(f64::NAN),
+                size: v.dr.unwrap_or(0.0),
+                color: class_color(Some(v.class)).into(),
+                marker: class_marker(Some(v.class)).unwrap_or(Marker::Circle),
+                label: format!(
+                    "{}: added mass {}, ΔQTR {} %, ΔQIT {} %, ΔR {} %",
+                    v.display_name(),
+                    crate::format::mass(mass(v)),
+                    crate::format::percent(v.dqtr.unwrap_or(f64::NAN)),
+                    crate::format::percent(v.dqit.unwrap_or(f64::NAN)),
+                    crate::format::percent(v.dr.unwrap_or(f64::NAN))
+                ),
+                callout: callouts
+                    .iter()
+                    .find(|(id, _)| *id == v.id)
+                    .map(|(_, scopes)| format!("{} ({})", name, scopes.join(", "))),
+            }
+        })
+        .collect();
+    // Non-dominated on (added mass, ΔQTR): sorted by mass, each point better than all lighter.
+    let mut sorted: Vec<(f64, f64)> = points.iter().map(|p| (p.x, p.y)).collect();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut front: Vec<(f64, f64)> = Vec::new();
+    for (x, y) in sorted {
+        if front.last().is_none_or(|&(_, best)| y < best) {
+            front.push((x, y));
+        }
+    }
+    let best = leader.dqtr?;
+    let x_label = match r.moving_mass {
+        Some(m) => format!(
+            "added mass [kg] (the moving mass is {})",
+            crate::format::mass(m)
+        ),
+        None => "added mass [kg]".into(),
+    };
+    let chart = ScatterChart {
+        title: "Motor effort against added mass".into(),
+        subtitle: Some(
+            "lower left is better; dashed: no variant is both lighter and lower on ΔQTR".into(),
+        ),
+        x_label,
+        y_label: "ΔQTR [%]".into(),
+        points,
+        legend: Class::ALL
+            .iter()
+            .filter(|c| ranked.iter().any(|v| v.class == **c))
+            .map(|&c| {
+                (
+                    c.title().to_string(),
+                    class_color(Some(c)).to_string(),
+                    class_marker(Some(c)).unwrap_or(Marker::Circle),
+                )
+            })
+            .collect(),
+        size_max,
+        size_label: "ΔR".into(),
+        band: Some((
+            best,
+            best + decision.tolerance,
+            format!(
+                "within {} pp of {}",
+                crate::format::compact(decision.tolerance),
+                leader.name.clone().unwrap_or_default()
+            ),
+        )),
+        front,
+        width: 760.0,
+        height: 430.0,
+    };
+    Some(Chart {
+        section: Section::Decision,
+        title: chart.title.clone(),
+        svg: scatter_chart(&chart),
+    })
 }
 
 fn curve_class(r: &RunResults, variant: Option<usize>) -> Option<Class> {
     variant.and_then(|id| r.variant(id)).map(|v| v.class)
 }
 
+/// Line style of the `k`-th curve of a chart: the unbalanced robot dashed grey without marker,
+/// the variants in their class colour and marker, with a dash pattern by position.
+fn curve_style(
+    r: &RunResults,
+    k: usize,
+    variant: Option<usize>,
+) -> (String, Option<String>, Option<Marker>) {
+    let class = curve_class(r, variant);
+    let dash = match variant {
+        None => Some("6 3".to_string()),
+        Some(_) => DASHES[k.saturating_sub(1) % DASHES.len()].map(str::to_string),
+    };
+    (class_color(class).to_string(), dash, class_marker(class))
+}
+
+/// Largest |value| of a set of curves: the scale of a figure's noise floor.
+fn scale<'a>(values: impl Iterator<Item = &'a f64>) -> f64 {
+    values
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
 /// Motor torque of UB and the best variants on the critical tasks.
 fn torque(r: &RunResults) -> Vec<Chart> {
+    let figure_scale = scale(
+        r.torque_charts
+            .iter()
+            .flat_map(|c| c.curves.iter().flat_map(|k| k.values.iter())),
+    );
     r.torque_charts
         .iter()
         .map(|c| {
@@ -138,18 +379,25 @@ fn torque(r: &RunResults) -> Vec<Chart> {
                 subtitle: Some(critical_summary(&c.critical_for)),
                 x_label: "time [s]".into(),
                 y_label: "motor torque [N·m]".into(),
+                y_unit: "N·m".into(),
                 series: c
                     .curves
                     .iter()
-                    .map(|curve| LineSeries {
-                        label: curve.label.clone(),
-                        color: class_color(curve_class(r, curve.variant)).into(),
-                        dashed: curve.variant.is_none(),
-                        x: c.t.clone(),
-                        y: curve.values.clone(),
+                    .enumerate()
+                    .map(|(k, curve)| {
+                        let (color, dash, marker) = curve_style(r, k, curve.variant);
+                        LineSeries {
+                            label: curve.label.clone(),
+                            color,
+                            dash,
+                            marker,
+                            x: c.t.clone(),
+                            y: curve.values.clone(),
+                        }
                     })
                     .collect(),
                 include_zero: true,
+                noise_scale: Some(figure_scale),
                 width: 560.0,
                 height: 330.0,
             };
@@ -215,6 +463,11 @@ fn path_charts(
     } else {
         format!("{} [{}]", run.x_label, run.x_unit)
     };
+    let figure_scale = scale(
+        run.mechanisms
+            .iter()
+            .flat_map(|m| m.torques.iter().flat_map(|t| t.iter())),
+    );
     actuators
         .iter()
         .enumerate()
@@ -225,20 +478,25 @@ fn path_charts(
                 subtitle: None,
                 x_label: x_label.clone(),
                 y_label: "motor torque [N·m]".into(),
+                y_unit: "N·m".into(),
                 series: run
                     .mechanisms
                     .iter()
-                    .filter_map(|m| {
+                    .enumerate()
+                    .filter_map(|(k, m)| {
+                        let (color, dash, marker) = curve_style(r, k, m.variant);
                         Some(LineSeries {
                             label: m.label.clone(),
-                            color: class_color(curve_class(r, m.variant)).into(),
-                            dashed: m.variant.is_none(),
+                            color,
+                            dash,
+                            marker,
                             x: run.x.clone(),
                             y: m.torques.get(a)?.clone(),
                         })
                     })
                     .collect(),
                 include_zero: true,
+                noise_scale: Some(figure_scale),
                 width: 560.0,
                 height: 330.0,
             };

@@ -6,7 +6,7 @@ use crate::format::csv_field;
 use crate::results::RunResults;
 
 /// Column names, in order.
-pub const HEADER: [&str; 16] = [
+pub const HEADER: [&str; 22] = [
     "rank",
     "class_rank",
     "name",
@@ -18,6 +18,12 @@ pub const HEADER: [&str; 16] = [
     "dqtr_percent",
     "dqit_percent",
     "dr_percent",
+    "added_mass_kg",
+    "added_mass_percent",
+    "elements_count",
+    "peak_spring_force_n",
+    "peak_spring_elongation_m",
+    "peak_counterweight_offset_m",
     "objective_nm",
     "gap",
     "iterations",
@@ -34,6 +40,7 @@ pub fn render(r: &RunResults) -> String {
     for v in r.ranked() {
         let o = v.optimiser.clone().unwrap_or_default();
         let e = v.evaluation.as_ref();
+        let p = v.practical.as_ref();
         let fields = [
             v.rank.map(|x| x.to_string()).unwrap_or_default(),
             v.class_rank.map(|x| x.to_string()).unwrap_or_default(),
@@ -46,6 +53,12 @@ pub fn render(r: &RunResults) -> String {
             num(v.dqtr),
             num(v.dqit),
             num(v.dr),
+            num(p.map(|p| p.added_mass)),
+            num(p.and_then(|p| p.added_mass_percent)),
+            v.elements.len().to_string(),
+            num(p.and_then(|p| p.peak_spring_force)),
+            num(p.and_then(|p| p.peak_spring_elongation)),
+            num(p.and_then(|p| p.peak_counterweight_offset)),
             num(o.objective),
             num(o.gap),
             o.iterations.map(|x| x.to_string()).unwrap_or_default(),

@@ -142,6 +142,23 @@ pub fn seconds(s: f64) -> String {
     }
 }
 
+/// A mass for prose: `0 kg`, `12.00 kg`.
+pub fn mass(kg: f64) -> String {
+    format!("{} kg", value(kg))
+}
+
+/// A force with an engineering prefix: `850.0 N`, `3.00 kN`, `1.20 MN`.
+pub fn force(n: f64) -> String {
+    let a = n.abs();
+    if a >= 1e6 {
+        format!("{} MN", value(n / 1e6))
+    } else if a >= 1e3 {
+        format!("{} kN", value(n / 1e3))
+    } else {
+        format!("{} N", value(n))
+    }
+}
+
 /// A task `[from, to]` for people.
 pub fn task(t: [usize; 2]) -> String {
     format!("{}→{}", t[0], t[1])
@@ -177,6 +194,11 @@ mod tests {
         assert_eq!(percent(0.6), "+0.60");
         assert_eq!(percent(0.0), "0.00");
         assert_eq!(percent(-0.001), "0.00");
+        assert_eq!(mass(0.0), "0 kg");
+        assert_eq!(mass(2.0), "2.00 kg");
+        assert_eq!(force(850.0), "850.0 N");
+        assert_eq!(force(3000.0), "3.00 kN");
+        assert_eq!(force(1.2e6), "1.20 MN");
     }
 
     #[test]

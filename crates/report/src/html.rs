@@ -6,7 +6,7 @@ use std::fmt::Write;
 
 use crate::charts::{self, Chart, Section};
 use crate::format::{escape_html as esc, value};
-use crate::results::RunResults;
+use crate::results::{RunResults, VariantStatus};
 use crate::tables::{self, Table};
 
 const CSS: &str = r#"
@@ -36,6 +36,8 @@ table.kv td:first-child { color: var(--muted); padding-right: 18px; }
 .charts { display: flex; flex-wrap: wrap; gap: 18px; }
 .charts figure { margin: 0; border: 1px solid var(--line); border-radius: 4px; padding: 4px; }
 svg.chart { display: block; max-width: 100%; height: auto; }
+ul.why { margin: 4px 0 12px; padding-left: 20px; max-width: 980px; }
+ul.why li { margin: 3px 0; }
 ul.rel { margin: 4px 0 10px; padding-left: 20px; }
 ul.rel code { font: 12.5px/1.5 ui-monospace, SFMono-Regular, Menlo, Consolas, monospace; }
 details { margin: 8px 0; }
@@ -68,11 +70,14 @@ pub fn render(r: &RunResults) -> String {
         let _ = write!(h, "<p class=\"note\">{}</p>", esc(note));
     }
 
+    push_decision(&mut h, r, &charts);
+
     h.push_str("<h2>Summary</h2>");
     let best = tables::best_per_class(r);
     if best.rows.is_empty() {
         h.push_str("<p>No feasible balanced variant was found.</p>");
     } else {
+        h.push_str("<h3>Best-ranked variant of each class</h3>");
         h.push_str(&table(&best, ""));
         h.push_str(&sign_note(r));
     }
@@ -80,9 +85,9 @@ pub fn render(r: &RunResults) -> String {
     h.push_str(&table(&tables::metadata(r), "kv"));
     h.push_str("</div><div><h3>Timings</h3>");
     h.push_str(&table(&tables::timings(r), ""));
-    h.push_str("</div><div><h3>Variants by status</h3>");
+    h.push_str("</div></div><h3>Variants by status</h3>");
     h.push_str(&table(&tables::counts(r), ""));
-    h.push_str("</div></div>");
+    h.push_str("<p class=\"note\">Only <i>feasible</i> variants are ranked. Balanced ones are feasible, discarded or undecided; unrealizable and degenerate ones balance only on paper (no physical elements, or an element that can only idle); infeasible ones do not balance.</p>");
 
     h.push_str("<h2>Unbalanced robot (Phase 1)</h2><div class=\"cols\"><div>");
     h.push_str(&table(&tables::unbalanced_summary(r), ""));
@@ -109,16 +114,26 @@ pub fn render(r: &RunResults) -> String {
     } else {
         h.push_str(&table(&ranking, ""));
         h.push_str(&ranking_note(r));
+        h.push_str(OBJECTIVE_NOTE);
         push_charts(&mut h, &charts, Section::Ranking);
+        h.push_str("<h3>Practical figures</h3>");
+        h.push_str(&table(&tables::practical(r), ""));
+        h.push_str(&practical_note(r));
         h.push_str("<h3>Optimised parameters (Table 1)</h3>");
         h.push_str(&table(&tables::parameters(r), ""));
         h.push_str("<p class=\"note\">Spring: stiffness K, anchor a on the first body and b on the second, as distance and angle in the element's plane (body frames). Counterweight: mass m, offset r and angle φ of its centre of mass in the body frame.</p>");
+        let joints = tables::joint_reactions(r);
+        if !joints.rows.is_empty() {
+            h.push_str("<h3>Joint reactions of the ranked variants (ΔR breakdown)</h3>");
+            h.push_str(&table(&joints, ""));
+            h.push_str("<p class=\"note\">ΔF_j, ΔM_j: variation of the peak joint force and moment against the unbalanced robot; γ: the joint's share of the unbalanced reactions (Eqs. 20–21); the ΔR term adds the weighted increases only.</p>");
+        }
     }
 
     if r.torque_charts.is_empty() {
         h.push_str("<h2>Torque curves</h2><p class=\"muted\">No torque curves were recorded.</p>");
     } else {
-        h.push_str("<h2>Motor torques on the critical tasks</h2><p class=\"note\">Unbalanced robot (dashed grey) and the best variant of each class. Blue: counterweights only, green: springs only, orange: hybrid.</p>");
+        h.push_str("<h2>Motor torques on the critical tasks</h2><p class=\"note\">Unbalanced robot (dashed grey) and the best-ranked variant of each class: blue circles counterweights only, green squares springs only, orange triangles hybrid; coinciding curves differ by dash pattern.</p>");
         push_charts(&mut h, &charts, Section::Torque);
     }
 
@@ -141,9 +156,25 @@ pub fn render(r: &RunResults) -> String {
         }
     }
 
+    let others = tables::not_ranked(r);
+    if !others.rows.is_empty() {
+        let _ = write!(
+            h,
+            "<h2>Variants not ranked</h2><details><summary>{} (reasons)</summary>",
+            esc(&not_ranked_summary(r))
+        );
+        h.push_str(&table(&others, ""));
+        h.push_str("</details>");
+    }
+
     let ranked = r.ranked();
     if !ranked.is_empty() {
-        h.push_str("<h2>Balance relations</h2><p class=\"note\">What exact balance imposes on each ranked variant's lifted parameters (m, m·r, K, K·a, K·b, K·a·bᵀ), the freedom left inside the balanced family, and the verification of the optimised parameters (relative spread of the total potential energy at random configurations).</p>");
+        let _ = write!(
+            h,
+            "<h2>Appendix</h2><details><summary>Balance relations and free directions of the {} ranked variants</summary>",
+            ranked.len()
+        );
+        h.push_str("<p class=\"note\">What exact balance imposes on each ranked variant's lifted parameters (m, m·r, K, K·a, K·b, K·a·bᵀ), the freedom left inside the balanced family, and the verification of the optimised parameters (relative spread of the total potential energy at random configurations).</p>");
         for v in &ranked {
             let _ = write!(
                 h,
@@ -170,24 +201,6 @@ pub fn render(r: &RunResults) -> String {
                 );
             }
         }
-        let joints = tables::joint_reactions(r);
-        if !joints.rows.is_empty() {
-            h.push_str(
-                "<details><summary>Joint reactions of the ranked variants (ΔR breakdown)</summary>",
-            );
-            h.push_str(&table(&joints, ""));
-            h.push_str("</details>");
-        }
-    }
-
-    let others = tables::not_ranked(r);
-    if !others.rows.is_empty() {
-        let _ = write!(
-            h,
-            "<h2>Other balanced variants</h2><details><summary>{} variants balance the mechanism but were not ranked (reasons)</summary>",
-            others.rows.len()
-        );
-        h.push_str(&table(&others, ""));
         h.push_str("</details>");
     }
 
@@ -200,6 +213,90 @@ pub fn render(r: &RunResults) -> String {
     );
     h.push('\n');
     h
+}
+
+/// What the optimiser's two columns mean.
+pub const OBJECTIVE_NOTE: &str = "<p class=\"note\"><b>Objective</b>: the value the optimiser minimised, at the returned parameters, N·m: RMS* (paper Eq. 11, the energy estimate of the motor torques over the critical tasks) or, with <code>--minimax</code>, QTR. <b>Gap</b>: (objective − lower bound) / objective, where the lower bound is certified by the convex relaxation: no parameters within the bounds can improve the objective by more than this fraction (1.0e-3 = 0.1 %).</p>";
+
+/// The decision section: recommendations, the rule, the Pareto chart and the equivalent group.
+fn push_decision(h: &mut String, r: &RunResults, charts: &[Chart]) {
+    let Some(d) = &r.decision else { return };
+    let recs = tables::recommendations(r);
+    if recs.rows.is_empty() {
+        return;
+    }
+    h.push_str("<h2>Which variant to build</h2>");
+    h.push_str(&table(&recs, ""));
+    h.push_str("<ul class=\"why\">");
+    for (scope, reason) in tables::reasons(r) {
+        let _ = write!(h, "<li><b>{}.</b> {}</li>", esc(&scope), esc(&reason));
+    }
+    h.push_str("</ul>");
+    let _ = write!(h, "<p class=\"note\"><b>Rule.</b> {}</p>", esc(&d.rule));
+    h.push_str(&practical_note(r));
+    push_charts(h, charts, Section::Decision);
+    let group = tables::equivalent_group(r);
+    if group.rows.len() > 1 {
+        let _ = write!(
+            h,
+            "<details open=\"open\"><summary>The {} variants equivalent to the best-ranked one (within {} percentage points on ΔQTR and ΔQIT)</summary>",
+            group.rows.len(),
+            crate::format::compact(d.tolerance)
+        );
+        h.push_str(&table(&group, ""));
+        h.push_str("</details>");
+    }
+}
+
+/// Where the practical figures come from.
+fn practical_note(r: &RunResults) -> String {
+    let mass = r
+        .moving_mass
+        .map(|m| {
+            format!(
+                " Shares are of the moving mass, {} (every body).",
+                crate::format::mass(m)
+            )
+        })
+        .unwrap_or_default();
+    let basis = r
+        .spring_peaks_basis
+        .as_ref()
+        .map(|b| format!(" Peak spring force and stretch: {b}."))
+        .unwrap_or_default();
+    format!(
+        "<p class=\"note\">Added mass: the counterweights' total (springs are massless). Parts: elements to mount. Stretch: the spring's anchor distance (zero free length), force = K·stretch. Offset: a counterweight's centre-of-mass distance from its body origin.{}{}</p>",
+        esc(&mass),
+        esc(&basis)
+    )
+}
+
+/// `202 not ranked: 23 discarded (…), 146 unrealizable (…), …`.
+pub fn not_ranked_summary(r: &RunResults) -> String {
+    let parts: Vec<String> = r
+        .counts
+        .iter()
+        .filter(|c| {
+            c.total > 0
+                && !matches!(
+                    c.status,
+                    VariantStatus::Feasible | VariantStatus::Infeasible
+                )
+        })
+        .map(|c| format!("{} {} ({})", c.total, c.status.name(), c.status.meaning()))
+        .collect();
+    let total: usize = r
+        .counts
+        .iter()
+        .filter(|c| {
+            !matches!(
+                c.status,
+                VariantStatus::Feasible | VariantStatus::Infeasible
+            )
+        })
+        .map(|c| c.total)
+        .sum();
+    format!("{total} variants not ranked: {}", parts.join("; "))
 }
 
 fn sign_note(r: &RunResults) -> String {

@@ -41,28 +41,36 @@
 //! ```
 //!
 //! Modules, one job each: [`indicators`] (Eqs. 15–21), [`ranking`] (lexicographic order at a
-//! resolution), [`results`] (the schema and `finalize`), [`tables`] (the tables both reports
+//! resolution), [`practical`] (added mass, element count, spring and offset peaks),
+//! [`decision`] (equivalence groups and recommendations), [`results`] (the schema and
+//! `finalize`), [`tables`] (the tables both reports
 //! share), [`svg`] (hand-written charts), [`charts`] (which charts), [`html`], [`markdown`],
 //! [`csv`], [`text`] (terminal summary), [`output`] (atomic files), [`format`] (numbers and
 //! escaping).
 
 pub mod charts;
 pub mod csv;
+pub mod decision;
 pub mod format;
 pub mod html;
 pub mod indicators;
 pub mod markdown;
 pub mod output;
+pub mod practical;
 pub mod ranking;
 pub mod results;
 pub mod svg;
 pub mod tables;
 pub mod text;
 
+pub use decision::{Decision, Recommendation, decide};
 pub use indicators::{
     DeltaR, IndicatorError, JointReaction, JointVariation, delta_r, percent_variation,
 };
-pub use output::{OutputError, read_results, regenerate, write_atomic, write_outputs};
+pub use output::{
+    OutputError, read_results, regenerate, regenerate_with, write_atomic, write_outputs,
+};
+pub use practical::{PracticalFigures, SpringPeak};
 pub use ranking::{Class, RankItem, Ranking, RankingError, RankingOptions, rank};
 pub use results::{
     ActuatorSummary, CounterweightParams, CriticalTask, Curve, ElementInfo, ElementKind,

@@ -24,6 +24,27 @@ pub fn render(r: &RunResults) -> String {
     for note in &m.notes {
         let _ = writeln!(s, "> {}\n", esc(note));
     }
+    let recs = tables::recommendations(r);
+    if let (Some(d), false) = (&r.decision, recs.rows.is_empty()) {
+        section(&mut s, "Which variant to build", &recs);
+        for (scope, reason) in tables::reasons(r) {
+            let _ = writeln!(s, "- **{}.** {}", esc(&scope), esc(&reason));
+        }
+        s.push('\n');
+        let _ = writeln!(s, "**Rule.** {}\n", esc(&d.rule));
+        let group = tables::equivalent_group(r);
+        if group.rows.len() > 1 {
+            let _ = writeln!(
+                s,
+                "### The {} variants equivalent to the best-ranked one\n",
+                group.rows.len()
+            );
+            table(&mut s, &group);
+        }
+        s.push_str(
+            "The Pareto chart (ΔQTR against added mass, ΔR as marker size) is in report.html.\n\n",
+        );
+    }
     section(&mut s, "Summary", &tables::best_per_class(r));
     s.push_str(
         "ΔQTR and ΔQIT are percentage variations with respect to the unbalanced robot \
@@ -32,6 +53,10 @@ pub fn render(r: &RunResults) -> String {
     section(&mut s, "Run", &tables::metadata(r));
     section(&mut s, "Timings", &tables::timings(r));
     section(&mut s, "Variants by status", &tables::counts(r));
+    s.push_str(
+        "Only feasible variants are ranked. Unrealizable and degenerate ones balance only on \
+         paper; infeasible ones do not balance.\n\n",
+    );
     section(&mut s, "Unbalanced robot", &tables::unbalanced_summary(r));
     table(&mut s, &tables::unbalanced_actuators(r));
     if !r.unbalanced.joints.is_empty() {
@@ -48,6 +73,15 @@ pub fn render(r: &RunResults) -> String {
             esc(&info.tie_break)
         );
     }
+    s.push_str(
+        "Objective: the value the optimiser minimised at the returned parameters (RMS*, Eq. 11, \
+         or QTR with --minimax), N·m. Gap: (objective − lower bound)/objective, the lower bound \
+         certified by the convex relaxation.\n\n",
+    );
+    section(&mut s, "Practical figures", &tables::practical(r));
+    if let Some(b) = &r.spring_peaks_basis {
+        let _ = writeln!(s, "Peak spring force and stretch: {}.\n", esc(b));
+    }
     section(
         &mut s,
         "Optimised parameters (Table 1)",
@@ -62,7 +96,23 @@ pub fn render(r: &RunResults) -> String {
     }
     let ranked = r.ranked();
     if !ranked.is_empty() {
-        s.push_str("## Balance relations\n\n");
+        section(
+            &mut s,
+            "Joint reactions of the ranked variants",
+            &tables::joint_reactions(r),
+        );
+    }
+    let others = tables::not_ranked(r);
+    if !others.rows.is_empty() {
+        let _ = writeln!(
+            s,
+            "## Variants not ranked\n\n{}.\n",
+            esc(&crate::html::not_ranked_summary(r))
+        );
+        table(&mut s, &others);
+    }
+    if !ranked.is_empty() {
+        s.push_str("## Appendix: balance relations\n\n<details><summary>Balance relations and free directions of the ranked variants</summary>\n\n");
         for v in ranked {
             let _ = writeln!(s, "### {} — {}\n", esc(&v.display_name()), v.class.name());
             for line in tables::relations(v) {
@@ -73,15 +123,7 @@ pub fn render(r: &RunResults) -> String {
             }
             s.push('\n');
         }
-        section(
-            &mut s,
-            "Joint reactions of the ranked variants",
-            &tables::joint_reactions(r),
-        );
-    }
-    let others = tables::not_ranked(r);
-    if !others.rows.is_empty() {
-        section(&mut s, "Other balanced variants (not ranked)", &others);
+        s.push_str("</details>\n");
     }
     s
 }

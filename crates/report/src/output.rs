@@ -18,13 +18,14 @@ pub const RANKING_CSV: &str = "ranking.csv";
 
 #[derive(Debug, Error)]
 pub enum OutputError {
-    #[error("{path}: {source}")]
+    // The OS reason is the source, printed once after the path by `{:#}` (anyhow's chain).
+    #[error("{path}")]
     Io {
         path: PathBuf,
         #[source]
         source: std::io::Error,
     },
-    #[error("{path}: not a valid results document: {source}")]
+    #[error("{path}: not a valid results document")]
     Parse {
         path: PathBuf,
         #[source]
@@ -112,6 +113,15 @@ pub fn read_results(dir: &Path) -> Result<RunResults, OutputError> {
 /// `counterpoise report DIR`: re-reads results.json and rewrites the three reports from it
 /// (results.json itself is left untouched). Returns the paths written.
 pub fn regenerate(dir: &Path) -> Result<Vec<PathBuf>, OutputError> {
-    let results = read_results(dir)?;
+    regenerate_with(dir, None)
+}
+
+/// [`regenerate`], with the decision section recomputed at `tolerance` (percentage points)
+/// when one is given.
+pub fn regenerate_with(dir: &Path, tolerance: Option<f64>) -> Result<Vec<PathBuf>, OutputError> {
+    let mut results = read_results(dir)?;
+    if let Some(t) = tolerance {
+        results.redecide(t);
+    }
     write_reports(dir, &results)
 }

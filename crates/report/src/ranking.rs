@@ -58,11 +58,22 @@ impl Class {
 pub struct RankingOptions {
     /// Values closer than this (percentage points) compare equal. Default 0.01.
     pub resolution: f64,
+    /// Tolerance of the decision section's equivalence groups, percentage points (see
+    /// [`crate::decision`]); it does not change the ranking. Default 0.5.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+}
+
+fn default_tolerance() -> f64 {
+    crate::decision::DEFAULT_TOLERANCE
 }
 
 impl Default for RankingOptions {
     fn default() -> Self {
-        RankingOptions { resolution: 0.01 }
+        RankingOptions {
+            resolution: 0.01,
+            tolerance: default_tolerance(),
+        }
     }
 }
 
@@ -96,6 +107,8 @@ pub struct Ranking {
 pub enum RankingError {
     #[error("ranking resolution must be finite and ≥ 0, got {0}")]
     BadResolution(f64),
+    #[error("equivalence tolerance must be finite and ≥ 0 percentage points, got {0}")]
+    BadTolerance(f64),
     #[error("variant {key}: {criterion} is not finite ({value})")]
     NotFinite {
         key: String,
@@ -119,6 +132,9 @@ pub fn rank(items: &[RankItem], options: &RankingOptions) -> Result<Ranking, Ran
     let res = options.resolution;
     if !(res.is_finite() && res >= 0.0) {
         return Err(RankingError::BadResolution(res));
+    }
+    if !(options.tolerance.is_finite() && options.tolerance >= 0.0) {
+        return Err(RankingError::BadTolerance(options.tolerance));
     }
     for item in items {
         for (k, name) in CRITERIA.iter().enumerate() {
@@ -262,7 +278,10 @@ mod tests {
     #[test]
     fn resolution_boundary() {
         // Gap below the resolution ties (ΔR decides); gap of exactly the resolution separates.
-        let opts = RankingOptions { resolution: 0.25 };
+        let opts = RankingOptions {
+            resolution: 0.25,
+            ..Default::default()
+        };
         let tie = vec![
             item("x", Class::Counterweights, -10.0, 0.0, 5.0),
             item("y", Class::Counterweights, -10.0 + 0.125, 0.0, 1.0),
@@ -286,7 +305,10 @@ mod tests {
         ];
         assert_eq!(keys(&far, &rank(&far, &d).unwrap()), ["x", "y"]);
         // Zero resolution: exact comparison.
-        let exact = RankingOptions { resolution: 0.0 };
+        let exact = RankingOptions {
+            resolution: 0.0,
+            ..Default::default()
+        };
         assert_eq!(keys(&near, &rank(&near, &exact).unwrap()), ["x", "y"]);
     }
 
@@ -356,7 +378,13 @@ mod tests {
             Err(RankingError::NotFinite { .. })
         ));
         assert!(matches!(
-            rank(&[], &RankingOptions { resolution: -1.0 }),
+            rank(
+                &[],
+                &RankingOptions {
+                    resolution: -1.0,
+                    ..Default::default()
+                }
+            ),
             Err(RankingError::BadResolution(_))
         ));
         assert!(

@@ -17,11 +17,14 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::decision::{Decision, decide};
 use crate::indicators::{DeltaR, IndicatorError, JointReaction, delta_r, percent_variation};
+use crate::practical::PracticalFigures;
 use crate::ranking::{Class, RankItem, RankingError, RankingOptions, rank};
 
 /// Version of the results.json layout.
-pub const SCHEMA_VERSION: u32 = 1;
+/// Version 2 added the practical figures (`practical`), the moving mass and the decision.
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// A task: the move between two grid points, `[from, to]` (grid indices, as in the dynamics
 /// crate).
@@ -296,6 +299,10 @@ pub struct VariantRecord {
     pub evaluation: Option<Evaluation>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub optimiser: Option<OptimiserInfo>,
+    /// Added mass, element count, peak spring force and stretch, peak counterweight offset
+    /// (feasible variants; filled by the caller, see [`crate::practical`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub practical: Option<PracticalFigures>,
     // ---- Phase 3, filled by `finalize` for feasible variants ----
     /// Display name `SB<rank>` (SB1 = best overall).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -337,6 +344,7 @@ impl VariantRecord {
             parameters: None,
             evaluation: None,
             optimiser: None,
+            practical: None,
             name: None,
             dqtr: None,
             dqit: None,
@@ -522,6 +530,16 @@ pub struct RunResults {
     pub torque_charts: Vec<TorqueChart>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub path: Option<PathSimulation>,
+    /// Sum of the bodies' masses (every body moves; payloads excluded), kg: the reference of
+    /// the added-mass shares.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moving_mass: Option<f64>,
+    /// Where the peak spring forces and stretches were taken, in words.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spring_peaks_basis: Option<String>,
+    /// Equivalence groups and recommendations (filled by `finalize`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decision: Option<Decision>,
 }
 
 impl RunResults {
@@ -537,6 +555,9 @@ impl RunResults {
             ranking: None,
             torque_charts: Vec::new(),
             path: None,
+            moving_mass: None,
+            spring_peaks_basis: None,
+            decision: None,
         }
     }
 
@@ -607,6 +628,7 @@ impl RunResults {
                 .map(|g| g.iter().map(|&k| self.variants[ranked[k]].id).collect())
                 .collect(),
         });
+        self.decision = Some(decide(&self.ranked(), options.tolerance, self.moving_mass));
         if let Some(path) = &mut self.path {
             path.table = match &path.dynamic_run {
                 Some(run) => path_table(&path.name, &path.actuators, run)?,
@@ -614,6 +636,11 @@ impl RunResults {
             };
         }
         Ok(())
+    }
+
+    /// Recomputes only the decision, at another tolerance (`counterpoise report --tolerance`).
+    pub fn redecide(&mut self, tolerance: f64) {
+        self.decision = Some(decide(&self.ranked(), tolerance, self.moving_mass));
     }
 
     /// Feasible variants in global rank order (after `finalize`).

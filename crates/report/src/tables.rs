@@ -245,6 +245,8 @@ pub fn ranking(r: &RunResults) -> Table {
         "ΔQTR [%]",
         "ΔQIT [%]",
         "ΔR [%]",
+        "Added mass [kg]",
+        "Peak spring force [N]",
         "Objective [N·m]",
         "Gap",
         "Note",
@@ -252,6 +254,7 @@ pub fn ranking(r: &RunResults) -> Table {
     for v in r.ranked() {
         let eval = v.evaluation.as_ref();
         let optim = v.optimiser.as_ref();
+        let practical = v.practical.as_ref();
         t.push(
             vec![
                 Cell::num(v.rank.map(|x| x.to_string()).unwrap_or_default()),
@@ -264,10 +267,12 @@ pub fn ranking(r: &RunResults) -> Table {
                 Cell::num(opt(v.dqtr, percent)),
                 Cell::num(opt(v.dqit, percent)),
                 Cell::num(opt(v.dr, percent)),
+                Cell::num(opt(practical.map(|p| p.added_mass), value)),
+                Cell::num(opt(practical.and_then(|p| p.peak_spring_force), value)),
                 Cell::num(opt(optim.and_then(|o| o.objective), value)),
                 Cell::num(opt(optim.and_then(|o| o.gap), |g| format!("{:.1e}", g))),
                 Cell::text(if v.tie_broken_by_label {
-                    "tie broken by labels"
+                    "label tie-break"
                 } else {
                     ""
                 }),
@@ -547,4 +552,152 @@ pub fn relations(v: &VariantRecord) -> Vec<String> {
         lines.push(line);
     }
     lines
+}
+
+/// `12.00 (1.0 %)`-style cells of the practical figures, shared by the decision tables.
+fn practical_cells(v: &VariantRecord) -> Vec<Cell> {
+    let p = v.practical.as_ref();
+    vec![
+        Cell::num(opt(p.map(|p| p.added_mass), value)),
+        Cell::num(opt(p.and_then(|p| p.added_mass_percent), |x| fixed(x, 1))),
+        Cell::num(
+            p.map(|p| p.elements)
+                .unwrap_or(v.elements.len())
+                .to_string(),
+        ),
+        Cell::num(opt(p.and_then(|p| p.peak_spring_force), value)),
+        Cell::num(opt(p.and_then(|p| p.peak_spring_elongation), |x| {
+            fixed(x * 1000.0, 0)
+        })),
+        Cell::num(opt(p.and_then(|p| p.peak_counterweight_offset), |x| {
+            fixed(x * 1000.0, 0)
+        })),
+    ]
+}
+
+const PRACTICAL_HEADER: [&str; 6] = [
+    "Added mass [kg]",
+    "of moving mass [%]",
+    "Parts",
+    "Peak spring force [N]",
+    "Peak stretch [mm]",
+    "Peak offset [mm]",
+];
+
+/// The recommendations: overall first, then one per class, with the figures behind them and
+/// the reason.
+pub fn recommendations(r: &RunResults) -> Table {
+    let mut header = vec![
+        "Recommendation",
+        "Variant",
+        "Elements",
+        "Rank",
+        "Equivalent",
+        "ΔQTR [%]",
+        "ΔQIT [%]",
+        "ΔR [%]",
+    ];
+    header.extend(PRACTICAL_HEADER);
+    let mut t = Table::new(&header);
+    let Some(d) = &r.decision else {
+        return t;
+    };
+    for (k, rec) in d.overall.iter().chain(&d.classes).enumerate() {
+        let Some(v) = r.variant(rec.chosen) else {
+            continue;
+        };
+        let scope = match rec.class {
+            None => "Overall".to_string(),
+            Some(c) => c.title().to_string(),
+        };
+        let mut row = vec![
+            Cell::text(scope),
+            Cell::text(v.name.clone().unwrap_or_default()),
+            Cell::text(v.label()),
+            Cell::num(v.rank.map(|x| x.to_string()).unwrap_or_default()),
+            Cell::num(rec.equivalent.len().to_string()),
+            Cell::num(opt(v.dqtr, percent)),
+            Cell::num(opt(v.dqit, percent)),
+            Cell::num(opt(v.dr, percent)),
+        ];
+        row.extend(practical_cells(v));
+        t.push(row, k == 1);
+    }
+    t.without_empty_columns()
+}
+
+/// The variants equivalent to the overall leader (the material of the overall pick), in rank
+/// order; the pick is marked.
+pub fn equivalent_group(r: &RunResults) -> Table {
+    let mut header = vec![
+        "Rank",
+        "Variant",
+        "Elements",
+        "Class",
+        "ΔQTR [%]",
+        "ΔQIT [%]",
+        "ΔR [%]",
+    ];
+    header.extend(PRACTICAL_HEADER);
+    header.push("");
+    let mut t = Table::new(&header);
+    let Some(rec) = r.decision.as_ref().and_then(|d| d.overall.as_ref()) else {
+        return t;
+    };
+    for id in &rec.equivalent {
+        let Some(v) = r.variant(*id) else { continue };
+        let mut row = vec![
+            Cell::num(v.rank.map(|x| x.to_string()).unwrap_or_default()),
+            Cell::text(v.name.clone().unwrap_or_default()),
+            Cell::text(v.label()),
+            Cell::text(v.class.name()),
+            Cell::num(opt(v.dqtr, percent)),
+            Cell::num(opt(v.dqit, percent)),
+            Cell::num(opt(v.dr, percent)),
+        ];
+        row.extend(practical_cells(v));
+        row.push(Cell::text(if *id == rec.chosen {
+            "recommended"
+        } else {
+            ""
+        }));
+        t.push(row, false);
+    }
+    t.without_empty_columns()
+}
+
+/// Practical figures of every ranked variant.
+pub fn practical(r: &RunResults) -> Table {
+    let mut header = vec!["Rank", "Variant", "Elements", "Class"];
+    header.extend(PRACTICAL_HEADER);
+    let mut t = Table::new(&header);
+    for v in r.ranked() {
+        let mut row = vec![
+            Cell::num(v.rank.map(|x| x.to_string()).unwrap_or_default()),
+            Cell::text(v.name.clone().unwrap_or_default()),
+            Cell::text(v.label()),
+            Cell::text(v.class.name()),
+        ];
+        row.extend(practical_cells(v));
+        t.push(row, false);
+    }
+    t.without_empty_columns()
+}
+
+/// The recommendations' reasons, one sentence each, headed by their scope.
+pub fn reasons(r: &RunResults) -> Vec<(String, String)> {
+    let Some(d) = &r.decision else {
+        return Vec::new();
+    };
+    d.overall
+        .iter()
+        .chain(&d.classes)
+        .map(|rec| {
+            let scope = match rec.class {
+                None => "Overall".to_string(),
+                Some(c) => c.title().to_string(),
+            };
+            (scope, rec.reason.clone())
+        })
+        .collect()
 }

@@ -37,6 +37,13 @@ pub fn summary(r: &RunResults) -> String {
     }
     s.push_str("Best variant of each class (ΔQTR, ΔQIT in % vs unbalanced, negative = reduction; ΔR ≥ 0):\n");
     s.push_str(&aligned(&best));
+    if let Some(rec) = r.decision.as_ref().and_then(|d| d.overall.as_ref()) {
+        let _ = writeln!(
+            s,
+            "\nRecommended: {}\n(one per class, and the rule, in report.html)",
+            rec.reason
+        );
+    }
     let mut ranking = tables::ranking(r);
     let shown = ranking.rows.len().min(SUMMARY_RANKS);
     let hidden = ranking.rows.len() - shown;
@@ -45,6 +52,12 @@ pub fn summary(r: &RunResults) -> String {
     s.push_str(&aligned(&ranking));
     if hidden > 0 {
         let _ = writeln!(s, "… and {hidden} more in ranking.csv / report.html");
+    }
+    if r.ranked().iter().any(|v| v.optimiser.is_some()) {
+        s.push_str(
+            "Objective: what the optimiser minimised (RMS*, Eq. 11, or QTR with --minimax), N·m; \
+             Gap: (objective − certified lower bound)/objective.\n",
+        );
     }
     s
 }

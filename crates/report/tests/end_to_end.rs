@@ -99,6 +99,17 @@ fn feasible(id: usize, labels: &[&str], class: Class, e: Evaluation) -> VariantR
         VariantStatus::Feasible,
     );
     v.parameters = Some(params(labels));
+    // Every spring stretched to at most 0.8 m: 5669 N/m · 0.8 m = 4535.2 N.
+    let peaks = params(labels)
+        .springs
+        .iter()
+        .map(|s| SpringPeak::from_lengths(&s.label, s.stiffness, [0.5, 0.8]))
+        .collect();
+    v.practical = Some(PracticalFigures::new(
+        &params(labels),
+        Some(1188.625),
+        peaks,
+    ));
     v.evaluation = Some(e);
     v.relations = vec![format!("m4·r4x = −18.59 kg·m <{id}>")];
     v.free_directions = vec![FreeDirection {
@@ -441,9 +452,25 @@ fn writes_all_outputs_and_regenerates() {
 
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     let (svgs, tables) = check_xhtml(&html);
-    // 3 classes of bars + 3 torque charts + 3 static + 3 dynamic path charts.
+    // The Pareto chart + one bar chart (the three classes have 2, 2 and 1 ranked variants:
+    // fewer than 3 each, so they share it) + 3 torque charts + 3 static + 3 dynamic path charts.
     let charts = counterpoise_report::charts::all(&r);
-    assert_eq!(charts.len(), 12);
+    assert_eq!(charts.len(), 11);
+    assert_eq!(
+        charts[1].title,
+        "Counterweights only and Springs only and Hybrid — ranking indicators"
+    );
+    assert_eq!(
+        charts[1].svg.matches("<title>SB").count(),
+        5 * 3,
+        "5 groups of 3 bars"
+    );
+    // The decision comes first, in both reports.
+    let decision = html.find("Which variant to build").unwrap();
+    assert!(decision < html.find("<h2>Summary</h2>").unwrap());
+    assert!(html.contains(
+        "<summary>Balance relations and free directions of the 5 ranked variants</summary>"
+    ));
     assert_eq!(svgs, charts.len());
     assert!(tables >= 8);
     assert!(!html.contains("http://") || !html.contains("href="));
@@ -463,6 +490,11 @@ fn writes_all_outputs_and_regenerates() {
     assert_eq!(ranking_rows.len(), 5, "{md}");
     assert!(ranking_rows[0].starts_with("| 1 | SB1 | K42 + K43 |"));
     assert!(md.contains("## Optimised parameters (Table 1)"));
+    assert!(md.find("## Which variant to build").unwrap() < md.find("## Summary").unwrap());
+    // 2 springs of 4535.2 N peak; 228.6 kg per counterweight, 2 of them = 457.2 kg = 38.5 %
+    // of 1188.625 kg.
+    assert!(md.contains("| 457.2 | 38.5 | 2 |"), "{md}");
+    assert!(md.contains("| 4535 |"), "{md}");
     assert!(
         md.contains("| 998.9 | 0 |"),
         "Table 1 anchor in mm and angle"
@@ -599,8 +631,16 @@ fn terminal_summary() {
         .lines()
         .skip_while(|l| !l.starts_with("Ranking (top 5):"))
         .skip(1)
+        .take_while(|l| l.starts_with("  "))
         .collect();
     assert_eq!(ranking.len(), 1 + 5, "header and five rows: {s}");
+    // The optimiser's columns are explained under the table.
+    assert!(
+        s.contains("\nObjective: what the optimiser minimised"),
+        "{s}"
+    );
+    // The overall recommendation is stated.
+    assert!(s.contains("\nRecommended: "), "{s}");
     let mut ranked: Vec<(usize, String)> = r
         .variants
         .iter()

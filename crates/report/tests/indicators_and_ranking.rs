@@ -84,7 +84,13 @@ fn compare_at_is_strict_at_the_resolution() {
 fn resolution_must_be_finite_and_not_negative() {
     for bad in [f64::INFINITY, f64::NAN, -0.5] {
         assert!(matches!(
-            rank(&[], &RankingOptions { resolution: bad }),
+            rank(
+                &[],
+                &RankingOptions {
+                    resolution: bad,
+                    ..Default::default()
+                }
+            ),
             Err(RankingError::BadResolution(_))
         ));
     }
