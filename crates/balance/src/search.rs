@@ -584,6 +584,38 @@ mod tests {
         new_result(energy, &[(0, &catalogue.entries[0])])
     }
 
+    /// The names people read are the ones the JSON output carries (serde's lowercase renaming,
+    /// a second spelling of each name that does not go through `name`).
+    #[test]
+    fn status_and_class_names_are_the_serialized_ones() {
+        let serialized = |v: serde_json::Value| v.as_str().unwrap().to_string();
+        let statuses: Vec<String> = Status::ALL
+            .iter()
+            .map(|s| serialized(serde_json::to_value(s).unwrap()))
+            .collect();
+        assert_eq!(
+            statuses,
+            [
+                "balanced",
+                "degenerate",
+                "unrealizable",
+                "infeasible",
+                "undecided"
+            ]
+        );
+        for (status, name) in Status::ALL.iter().zip(&statuses) {
+            assert_eq!(status.name(), name);
+        }
+        for (class, name) in [
+            (Class::Counterweights, "counterweights"),
+            (Class::Springs, "springs"),
+            (Class::Hybrid, "hybrid"),
+        ] {
+            assert_eq!(serialized(serde_json::to_value(class).unwrap()), name);
+            assert_eq!(class.name(), name);
+        }
+    }
+
     #[test]
     fn a_witness_that_fails_verification_is_undecided_not_balanced() {
         let energy = rod();

@@ -138,3 +138,53 @@ pub fn element_energy(poses: &[Pose], gravity: [f64; 3], witness: &Witness) -> f
     }
     total
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::energy::BodyFrame;
+    use crate::realize::CounterweightParams;
+    use counterpoise_symbolic::{LinearAngle, PolyMat3, PolyVec3, TrigPoly, VarKind};
+
+    /// A turntable: one body turning about z, with gravity along z. Its unbalanced energy is zero
+    /// at every angle, so no spread can be measured relative to it.
+    fn turntable() -> MechanismEnergy {
+        MechanismEnergy {
+            kinds: vec![VarKind::Angle],
+            ranges: vec![(-3.0, 3.0)],
+            gravity: [0.0, 0.0, -9.81],
+            bodies: vec![BodyFrame {
+                name: "table".into(),
+                rotation: PolyMat3::rot_z(&LinearAngle::coordinate(0)),
+                origin: PolyVec3::zero(),
+            }],
+            unbalanced: TrigPoly::zero(),
+            exact: Err("built by hand".into()),
+        }
+    }
+
+    #[test]
+    fn a_mechanism_without_energy_swing_is_verified_by_the_absolute_spread() {
+        let checks = VerificationSet::new(&turntable());
+        // Hand calculation: a counterweight of 2 kg at (0.3, 0, 0.5) in the table frame stays at
+        // height 0.5 m whatever the angle, so its energy is −m·g·z = 2·9.81·0.5 = 9.81 J at every
+        // sample, and the total energy does not spread at all.
+        let witness = Witness {
+            counterweights: vec![CounterweightParams {
+                entry: 0,
+                body: 0,
+                mass: 2.0,
+                offset: [0.3, 0.0, 0.5],
+            }],
+            springs: Vec::new(),
+        };
+        let verification = checks.verify(&witness);
+        assert_eq!(verification.residual, 0.0);
+        assert_eq!(verification.samples, VERIFY_SAMPLES);
+        assert!(verification.passed);
+        // Nothing installed: the energy is zero everywhere, which balances too.
+        let nothing = checks.verify(&Witness::default());
+        assert_eq!(nothing.residual, 0.0);
+        assert!(nothing.passed);
+    }
+}
