@@ -616,6 +616,60 @@ mod tests {
         }
     }
 
+    /// A spring's variables `(K, αx, αy, βx, βy, Wxx, Wxy, Wyx, Wyy)` with the hand-written
+    /// balance equations `βx = 2·K`, `βy = 0`: its anchor `b = β/K = (2, 0)` is fixed, `α` is free.
+    /// A physical spring then has `W = α·b₀ᵀ`, i.e. `Wxx − 2αx = 0`, `Wxy = 0`, `Wyx − 2αy = 0`,
+    /// `Wyy = 0`.
+    #[test]
+    fn a_fixed_second_anchor_gives_the_hand_written_rows() {
+        use crate::exact::ExactBasis;
+        use counterpoise_symbolic::{Monomial, Rational};
+        let int = |v: &[i64]| -> Vec<num_bigint::BigInt> { v.iter().map(|&x| x.into()).collect() };
+        let q = |n: i64| Rational::from_integer(n.into());
+        // Rows: −2K + βx = 0 and βy = 0; the other seven variables appear in no equation.
+        let mut columns = vec![int(&[0, 0]); 9];
+        columns[0] = int(&[-2, 0]);
+        columns[3] = int(&[1, 0]);
+        columns[4] = int(&[0, 1]);
+        let basis = ExactBasis {
+            monomials: vec![Monomial::sine(0), Monomial::sine(1)],
+            unbalanced: int(&[0, 0]),
+            elements: vec![columns],
+            row_factors: vec![q(1), q(1)],
+        };
+        let solution = basis.solve(&[0]);
+        let entry = CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0, 1],
+                axes_b: vec![0, 1],
+            },
+            label: "K1".into(),
+            description: "a spring".into(),
+            variables: Vec::new(),
+            energy: Vec::new(),
+        };
+        let (anchors, rows) = fixed_anchor_equations(&solution, &[(0, &entry)]);
+        assert_eq!(anchors, vec!["K1's anchor b = (2, 0)".to_string()]);
+        let row = |terms: &[(usize, i64)]| {
+            let mut r = vec![q(0); 9];
+            for &(j, c) in terms {
+                r[j] = q(c);
+            }
+            r
+        };
+        assert_eq!(
+            rows,
+            vec![
+                row(&[(5, 1), (1, -2)]),
+                row(&[(6, 1)]),
+                row(&[(7, 1), (2, -2)]),
+                row(&[(8, 1)]),
+            ]
+        );
+    }
+
     #[test]
     fn a_witness_that_fails_verification_is_undecided_not_balanced() {
         let energy = rod();
