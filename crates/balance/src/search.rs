@@ -670,6 +670,71 @@ mod tests {
         );
     }
 
+    /// A spring whose balance equations fix `α = (2, 1)`, `β = (3, 2)`, `Wxx = Wyy = 1` and leave
+    /// `K`, `Wxy`, `Wyx` free. By hand, `K·W = α·βᵀ` needs `K = 2·3/1 = 6` from `xx` and
+    /// `K = 1·2/1 = 2` from `yy`: no spring exists. Each row alone has a positive root, so the
+    /// floating-point screen lets it pass; the exact rank-one test, run once no witness is found,
+    /// proves it unrealizable.
+    #[test]
+    fn a_rank_one_contradiction_the_screen_misses_is_still_proven() {
+        use crate::exact::ExactBasis;
+        use counterpoise_symbolic::{Monomial, Rational};
+        use nalgebra::{DMatrix, DVector};
+        // Row r fixes variable fixed[r] to value[r]: coefficient 1, unbalanced −value.
+        let fixed = [1usize, 2, 3, 4, 5, 8];
+        let value = [2i64, 1, 3, 2, 1, 1];
+        let rows = fixed.len();
+        let exact = ExactBasis {
+            monomials: (0..rows).map(Monomial::sine).collect(),
+            unbalanced: value.iter().map(|&v| (-v).into()).collect(),
+            elements: vec![
+                (0..9)
+                    .map(|j| (0..rows).map(|r| i64::from(fixed[r] == j).into()).collect())
+                    .collect(),
+            ],
+            row_factors: vec![Rational::from_integer(1.into()); rows],
+        };
+        let basis = LiftedBasis {
+            monomials: exact.monomials.clone(),
+            unbalanced: DVector::from_iterator(rows, value.iter().map(|&v| -v as f64)),
+            elements: vec![DMatrix::from_fn(rows, 9, |r, j| f64::from(fixed[r] == j))],
+            exact: Some(exact),
+        };
+        let names = ["K1", "K1·ax", "K1·ay", "K1·bx", "K1·by"]
+            .into_iter()
+            .map(String::from)
+            .chain(["xx", "xy", "yx", "yy"].map(|ij| format!("K1·a{}·b{}", &ij[..1], &ij[1..])))
+            .collect();
+        let catalogue = Catalogue {
+            entries: vec![CatalogueEntry {
+                element: Element::Spring {
+                    body: 0,
+                    other: Attachment::Base,
+                    axes_a: vec![0, 1],
+                    axes_b: vec![0, 1],
+                },
+                label: "K1".into(),
+                description: "spring rod–base".into(),
+                variables: names,
+                energy: Vec::new(),
+            }],
+        };
+        let energy = rod();
+        let checks = VerificationSet::new(&energy);
+        let hints = RealizationHints::default();
+        let linear = crate::linear::from_exact(&basis, &basis.exact.as_ref().unwrap().solve(&[0]));
+        let entries = [(0, &catalogue.entries[0])];
+        assert!(crate::realize::rank_one_contradiction(&linear, &entries).is_none());
+        let result = decide(&energy, &catalogue, &basis, &checks, &[0], hints);
+        assert_eq!(result.decision, Decision::Exact);
+        assert_eq!((result.rank, result.nullity), (6, 3));
+        assert_eq!(result.status, Status::Unrealizable, "{:?}", result.reason);
+        assert_eq!(
+            result.reason.as_deref(),
+            Some("K1: balance would need the stiffness to be both 6 and 2 N/m")
+        );
+    }
+
     #[test]
     fn a_witness_that_fails_verification_is_undecided_not_balanced() {
         let energy = rod();
