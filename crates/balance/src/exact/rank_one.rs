@@ -271,6 +271,56 @@ mod tests {
         contradiction(&basis, &solution, &[&counterweight(), &spring()])
     }
 
+    /// A lone one-axis spring `(K, α, β, W)` with balance rows `Σ coefficient·x = rhs`.
+    fn lone_spring(rows: &[(&[(usize, i64)], i64)]) -> Option<String> {
+        let column = |j: usize| -> Vec<BigInt> {
+            rows.iter()
+                .map(|(terms, _)| {
+                    let c = terms.iter().find(|(k, _)| *k == j).map_or(0, |&(_, v)| v);
+                    BigInt::from(c)
+                })
+                .collect()
+        };
+        let basis = ExactBasis {
+            monomials: (0..rows.len()).map(Monomial::sine).collect(),
+            unbalanced: rows.iter().map(|&(_, v)| BigInt::from(-v)).collect(),
+            elements: vec![(0..4).map(column).collect()],
+            row_factors: vec![Rational::from_integer(1.into()); rows.len()],
+        };
+        let solution = basis.solve(&[0]);
+        assert!(solution.consistent());
+        let entry = CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0],
+                axes_b: vec![0],
+            },
+            ..spring()
+        };
+        contradiction(&basis, &solution, &[&entry])
+    }
+
+    #[test]
+    fn a_quadratic_residual_proves_nothing_unless_its_square_terms_cancel() {
+        // K = 1 and W = 1 fixed, α = z1 and β = z2 free: K·W − α·β = 1 − z1·z2 is zero on the
+        // hyperbola z1·z2 = 1 (a = b = 1 is a spring), so there is no proof.
+        assert_eq!(lone_spring(&[(&[(0, 1)], 1), (&[(3, 1)], 1)]), None);
+        // K = z, α = β = 2z, W = 4z + 1: K·W − α·β = 4z² + z − 4z² = z, zero only at K = 0.
+        assert_eq!(
+            lone_spring(&[
+                (&[(3, 1), (0, -4)], 1),
+                (&[(1, 1), (0, -2)], 0),
+                (&[(2, 1), (0, -2)], 0),
+            ]),
+            Some(
+                "K1: no spring has the anchors balance requires (K·W − α·βᵀ = 1·K on every \
+                 solution, zero only at K = 0 N/m)"
+                    .to_string()
+            )
+        );
+    }
+
     #[test]
     fn a_forced_stiffness_outside_the_positive_range_is_a_contradiction() {
         let outside = |form: &str, k: i64| {
