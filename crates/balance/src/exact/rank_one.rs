@@ -319,6 +319,25 @@ mod tests {
                     .to_string()
             )
         );
+        // K = 1, W = 4, α = β = z: K·W − α·β = 4 − z², zero at z = ±2 (a = b = 2): no proof.
+        assert_eq!(
+            lone_spring(&[(&[(0, 1)], 1), (&[(3, 1)], 4), (&[(1, 1), (2, -1)], 0)]),
+            None
+        );
+    }
+
+    #[test]
+    fn a_stiffness_with_a_constant_part_demands_the_hand_computed_value() {
+        // W = 4, β = 3 and K − α = 1 (K = 1 + z, α = z): K·W − α·β = 4K − 3(K − 1) = K + 3,
+        // zero only at K = −3: no positive spring.
+        assert_eq!(
+            lone_spring(&[(&[(3, 1)], 4), (&[(2, 1)], 3), (&[(0, 1), (1, -1)], 1)]),
+            Some(
+                "K1: no spring has the anchors balance requires (K·W − α·βᵀ = 3 + 1·K on every \
+                 solution, zero only at K = -3 N/m)"
+                    .to_string()
+            )
+        );
     }
 
     #[test]
