@@ -78,6 +78,19 @@ mod tests {
         }
     }
 
+    /// `C(n, k) = C(n, n − k)`: near `k = n` the product runs over the short side, so large
+    /// catalogues do not overflow u128 on the way. By hand: `C(n, n−1) = n`,
+    /// `C(200, 2) = 200·199/2 = 19900`, and `C(n, k) = 0` for `k > n`.
+    #[test]
+    fn binomials_near_k_equal_n_use_the_short_side() {
+        assert_eq!(binomial(200, 199), 200);
+        assert_eq!(binomial(200, 198), 19_900);
+        assert_eq!(binomial(200, 2), 19_900);
+        assert_eq!(binomial(200, 200), 1);
+        assert_eq!(binomial(200, 0), 1);
+        assert_eq!(binomial(5, 6), 0);
+    }
+
     #[test]
     fn variants_are_distinct_sorted_sets() {
         let all: Vec<_> = variants(6, 3).collect();

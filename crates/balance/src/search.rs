@@ -584,6 +584,157 @@ mod tests {
         new_result(energy, &[(0, &catalogue.entries[0])])
     }
 
+    /// The names people read are the ones the JSON output carries (serde's lowercase renaming,
+    /// a second spelling of each name that does not go through `name`).
+    #[test]
+    fn status_and_class_names_are_the_serialized_ones() {
+        let serialized = |v: serde_json::Value| v.as_str().unwrap().to_string();
+        let statuses: Vec<String> = Status::ALL
+            .iter()
+            .map(|s| serialized(serde_json::to_value(s).unwrap()))
+            .collect();
+        assert_eq!(
+            statuses,
+            [
+                "balanced",
+                "degenerate",
+                "unrealizable",
+                "infeasible",
+                "undecided"
+            ]
+        );
+        for (status, name) in Status::ALL.iter().zip(&statuses) {
+            assert_eq!(status.name(), name);
+        }
+        for (class, name) in [
+            (Class::Counterweights, "counterweights"),
+            (Class::Springs, "springs"),
+            (Class::Hybrid, "hybrid"),
+        ] {
+            assert_eq!(serialized(serde_json::to_value(class).unwrap()), name);
+            assert_eq!(class.name(), name);
+        }
+    }
+
+    /// A spring's variables `(K, αx, αy, βx, βy, Wxx, Wxy, Wyx, Wyy)` with the hand-written
+    /// balance equations `βx = 2·K`, `βy = 0`: its anchor `b = β/K = (2, 0)` is fixed, `α` is free.
+    /// A physical spring then has `W = α·b₀ᵀ`, i.e. `Wxx − 2αx = 0`, `Wxy = 0`, `Wyx − 2αy = 0`,
+    /// `Wyy = 0`.
+    #[test]
+    fn a_fixed_second_anchor_gives_the_hand_written_rows() {
+        use crate::exact::ExactBasis;
+        use counterpoise_symbolic::{Monomial, Rational};
+        let int = |v: &[i64]| -> Vec<num_bigint::BigInt> { v.iter().map(|&x| x.into()).collect() };
+        let q = |n: i64| Rational::from_integer(n.into());
+        // Rows: −2K + βx = 0 and βy = 0; the other seven variables appear in no equation.
+        let mut columns = vec![int(&[0, 0]); 9];
+        columns[0] = int(&[-2, 0]);
+        columns[3] = int(&[1, 0]);
+        columns[4] = int(&[0, 1]);
+        let basis = ExactBasis {
+            monomials: vec![Monomial::sine(0), Monomial::sine(1)],
+            unbalanced: int(&[0, 0]),
+            elements: vec![columns],
+            row_factors: vec![q(1), q(1)],
+        };
+        let solution = basis.solve(&[0]);
+        let entry = CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0, 1],
+                axes_b: vec![0, 1],
+            },
+            label: "K1".into(),
+            description: "a spring".into(),
+            variables: Vec::new(),
+            energy: Vec::new(),
+        };
+        let (anchors, rows) = fixed_anchor_equations(&solution, &[(0, &entry)]);
+        assert_eq!(anchors, vec!["K1's anchor b = (2, 0)".to_string()]);
+        let row = |terms: &[(usize, i64)]| {
+            let mut r = vec![q(0); 9];
+            for &(j, c) in terms {
+                r[j] = q(c);
+            }
+            r
+        };
+        assert_eq!(
+            rows,
+            vec![
+                row(&[(5, 1), (1, -2)]),
+                row(&[(6, 1)]),
+                row(&[(7, 1), (2, -2)]),
+                row(&[(8, 1)]),
+            ]
+        );
+    }
+
+    /// A spring whose balance equations fix `α = (2, 1)`, `β = (3, 2)`, `Wxx = Wyy = 1` and leave
+    /// `K`, `Wxy`, `Wyx` free. By hand, `K·W = α·βᵀ` needs `K = 2·3/1 = 6` from `xx` and
+    /// `K = 1·2/1 = 2` from `yy`: no spring exists. Each row alone has a positive root, so the
+    /// floating-point screen lets it pass; the exact rank-one test, run once no witness is found,
+    /// proves it unrealizable.
+    #[test]
+    fn a_rank_one_contradiction_the_screen_misses_is_still_proven() {
+        use crate::exact::ExactBasis;
+        use counterpoise_symbolic::{Monomial, Rational};
+        use nalgebra::{DMatrix, DVector};
+        // Row r fixes variable fixed[r] to value[r]: coefficient 1, unbalanced −value.
+        let fixed = [1usize, 2, 3, 4, 5, 8];
+        let value = [2i64, 1, 3, 2, 1, 1];
+        let rows = fixed.len();
+        let exact = ExactBasis {
+            monomials: (0..rows).map(Monomial::sine).collect(),
+            unbalanced: value.iter().map(|&v| (-v).into()).collect(),
+            elements: vec![
+                (0..9)
+                    .map(|j| (0..rows).map(|r| i64::from(fixed[r] == j).into()).collect())
+                    .collect(),
+            ],
+            row_factors: vec![Rational::from_integer(1.into()); rows],
+        };
+        let basis = LiftedBasis {
+            monomials: exact.monomials.clone(),
+            unbalanced: DVector::from_iterator(rows, value.iter().map(|&v| -v as f64)),
+            elements: vec![DMatrix::from_fn(rows, 9, |r, j| f64::from(fixed[r] == j))],
+            exact: Some(exact),
+        };
+        let names = ["K1", "K1·ax", "K1·ay", "K1·bx", "K1·by"]
+            .into_iter()
+            .map(String::from)
+            .chain(["xx", "xy", "yx", "yy"].map(|ij| format!("K1·a{}·b{}", &ij[..1], &ij[1..])))
+            .collect();
+        let catalogue = Catalogue {
+            entries: vec![CatalogueEntry {
+                element: Element::Spring {
+                    body: 0,
+                    other: Attachment::Base,
+                    axes_a: vec![0, 1],
+                    axes_b: vec![0, 1],
+                },
+                label: "K1".into(),
+                description: "spring rod–base".into(),
+                variables: names,
+                energy: Vec::new(),
+            }],
+        };
+        let energy = rod();
+        let checks = VerificationSet::new(&energy);
+        let hints = RealizationHints::default();
+        let linear = crate::linear::from_exact(&basis, &basis.exact.as_ref().unwrap().solve(&[0]));
+        let entries = [(0, &catalogue.entries[0])];
+        assert!(crate::realize::rank_one_contradiction(&linear, &entries).is_none());
+        let result = decide(&energy, &catalogue, &basis, &checks, &[0], hints);
+        assert_eq!(result.decision, Decision::Exact);
+        assert_eq!((result.rank, result.nullity), (6, 3));
+        assert_eq!(result.status, Status::Unrealizable, "{:?}", result.reason);
+        assert_eq!(
+            result.reason.as_deref(),
+            Some("K1: balance would need the stiffness to be both 6 and 2 N/m")
+        );
+    }
+
     #[test]
     fn a_witness_that_fails_verification_is_undecided_not_balanced() {
         let energy = rod();

@@ -138,3 +138,109 @@ pub fn element_energy(poses: &[Pose], gravity: [f64; 3], witness: &Witness) -> f
     }
     total
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::energy::BodyFrame;
+    use crate::realize::CounterweightParams;
+    use counterpoise_symbolic::{LinearAngle, PolyMat3, PolyVec3, TrigPoly, VarKind};
+
+    /// A turntable: one body turning about z, with gravity along z. Its unbalanced energy is zero
+    /// at every angle, so no spread can be measured relative to it.
+    fn turntable() -> MechanismEnergy {
+        MechanismEnergy {
+            kinds: vec![VarKind::Angle],
+            ranges: vec![(-3.0, 3.0)],
+            gravity: [0.0, 0.0, -9.81],
+            bodies: vec![BodyFrame {
+                name: "table".into(),
+                rotation: PolyMat3::rot_z(&LinearAngle::coordinate(0)),
+                origin: PolyVec3::zero(),
+            }],
+            unbalanced: TrigPoly::zero(),
+            exact: Err("built by hand".into()),
+        }
+    }
+
+    #[test]
+    fn element_energy_matches_a_hand_calculation() {
+        use crate::realize::SpringParams;
+        // Body 0 turned a quarter turn about z and moved to (1, 2, 3); body 1 unturned at
+        // (0, 0, 1). Gravity (−1, −2, −3) has a component along every axis.
+        let quarter = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let poses = [(quarter, [1.0, 2.0, 3.0]), (identity, [0.0, 0.0, 1.0])];
+        let gravity = [-1.0, -2.0, -3.0];
+        // 2 kg at (0.5, 0.25, −1) on body 0: R·r = (−0.25, 0.5, −1), world (0.75, 2.5, 2),
+        // g·x = −0.75 − 5 − 6 = −11.75, energy −m g·x = 23.5 J.
+        let counterweight = CounterweightParams {
+            entry: 0,
+            body: 0,
+            mass: 2.0,
+            offset: [0.5, 0.25, -1.0],
+        };
+        // K = 4 from (1, 0, 0) on body 0 — world (1, 2, 3) + (0, 1, 0) = (1, 3, 3) — to (0, 0, 2)
+        // on body 1 — world (0, 0, 3): d = (1, 3, 0), |d|² = 10, energy 4/2·10 = 20 J.
+        let between = SpringParams {
+            entry: 1,
+            body: 0,
+            other: Attachment::Body(1),
+            stiffness: 4.0,
+            anchor_a: [1.0, 0.0, 0.0],
+            anchor_b: [0.0, 0.0, 2.0],
+        };
+        // K = 3 from (1, 1, 0) on body 1 — world (1, 1, 1) — to the base point (1, 1, −1):
+        // d = (0, 0, 2), energy 3/2·4 = 6 J.
+        let to_base = SpringParams {
+            entry: 2,
+            body: 1,
+            other: Attachment::Base,
+            stiffness: 3.0,
+            anchor_a: [1.0, 1.0, 0.0],
+            anchor_b: [1.0, 1.0, -1.0],
+        };
+        let alone = |counterweights: Vec<CounterweightParams>, springs: Vec<SpringParams>| {
+            element_energy(
+                &poses,
+                gravity,
+                &Witness {
+                    counterweights,
+                    springs,
+                },
+            )
+        };
+        assert_eq!(alone(vec![counterweight.clone()], vec![]), 23.5);
+        assert_eq!(alone(vec![], vec![between.clone()]), 20.0);
+        assert_eq!(alone(vec![], vec![to_base.clone()]), 6.0);
+        assert_eq!(
+            alone(vec![counterweight], vec![between, to_base]),
+            23.5 + 20.0 + 6.0
+        );
+    }
+
+    #[test]
+    fn a_mechanism_without_energy_swing_is_verified_by_the_absolute_spread() {
+        let checks = VerificationSet::new(&turntable());
+        // Hand calculation: a counterweight of 2 kg at (0.3, 0, 0.5) in the table frame stays at
+        // height 0.5 m whatever the angle, so its energy is −m·g·z = 2·9.81·0.5 = 9.81 J at every
+        // sample, and the total energy does not spread at all.
+        let witness = Witness {
+            counterweights: vec![CounterweightParams {
+                entry: 0,
+                body: 0,
+                mass: 2.0,
+                offset: [0.3, 0.0, 0.5],
+            }],
+            springs: Vec::new(),
+        };
+        let verification = checks.verify(&witness);
+        assert_eq!(verification.residual, 0.0);
+        assert_eq!(verification.samples, VERIFY_SAMPLES);
+        assert!(verification.passed);
+        // Nothing installed: the energy is zero everywhere, which balances too.
+        let nothing = checks.verify(&Witness::default());
+        assert_eq!(nothing.residual, 0.0);
+        assert!(nothing.passed);
+    }
+}

@@ -9,6 +9,7 @@ use std::collections::HashMap;
 
 use common::{find, labels, model_of, palletizer_json, random_configuration, run};
 
+use counterpoise_balance::exact::exact_text;
 use counterpoise_balance::linear::{LiftedBasis, numeric_solve};
 use counterpoise_balance::{
     Catalogue, Decision, SearchReport, Status, VariantResult, Witness, catalogue_options,
@@ -16,6 +17,7 @@ use counterpoise_balance::{
 };
 use counterpoise_model::Kinematics;
 use counterpoise_model::sampling::SplitMix64;
+use counterpoise_symbolic::Rational;
 use nalgebra::{DVector, Vector3};
 
 fn counts(report: &SearchReport) -> [usize; 5] {
@@ -342,4 +344,124 @@ fn a_counterweight_on_the_column_is_redundant() {
     assert_eq!(v.redundant, vec!["m1".to_string()]);
     assert_eq!(find(&report, &["m4"]).relations[0], v.relations[0]);
     assert_eq!(find(&report, &["m1"]).status, Status::Infeasible);
+}
+
+/// A printed rational: `20`, or `5/9 (0.555556)` with its decimal beside it.
+fn parse_exact(text: &str) -> Rational {
+    let exact = text.split(" (").next().unwrap();
+    exact
+        .parse()
+        .unwrap_or_else(|_| panic!("not a rational: {text}"))
+}
+
+/// Every Farkas certificate the search prints checks by hand: with the multipliers read back
+/// from the text, `Σ λ_i h_i(z)` over the heads (masses and stiffnesses as affine functions of
+/// the free parameters) has no `z` term left and equals the printed value, which is ≤ 0. Dmax 3
+/// has integer multipliers other than 1 (`20·K71`) as well as fractions and plain labels.
+#[test]
+fn printed_farkas_certificates_check_by_hand() {
+    let model = model_of(&palletizer_json());
+    let energy = mechanism_energy(&model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+    let basis = LiftedBasis::build(&energy, &catalogue);
+    let exact = basis.exact.as_ref().expect("exact case");
+    let report = run(&model, 3);
+    let (mut checked, mut integer_multipliers) = (0, 0);
+    for v in &report.variants {
+        let Some(claim) = v
+            .reason
+            .as_deref()
+            .and_then(|r| r.strip_prefix("no positive masses and stiffnesses balance it: "))
+        else {
+            continue;
+        };
+        let (sum, value) = claim
+            .strip_prefix("every solution has ")
+            .and_then(|c| c.strip_suffix(" ≤ 0"))
+            .and_then(|c| c.rsplit_once(" = "))
+            .unwrap_or_else(|| panic!("{claim}"));
+        let value = parse_exact(value);
+        let set: Vec<usize> = v.elements.iter().map(|e| e.entry).collect();
+        let heads = exact.solve(&set).heads();
+        let zero = Rational::from_integer(0.into());
+        let mut constant = zero.clone();
+        let mut coefficients = vec![zero.clone(); heads[0].coefficients.len()];
+        for term in sum.split(" + ") {
+            let (lambda, label) = match term.split_once('·') {
+                Some((lambda, label)) => (parse_exact(lambda), label),
+                None => (Rational::from_integer(1.into()), term),
+            };
+            assert!(lambda > zero, "{claim}");
+            if lambda.is_integer() && lambda != Rational::from_integer(1.into()) {
+                integer_multipliers += 1;
+            }
+            let k = v.elements.iter().position(|e| e.label == label).unwrap();
+            constant += &lambda * &heads[k].constant;
+            for (c, h) in coefficients.iter_mut().zip(&heads[k].coefficients) {
+                *c += &lambda * h;
+            }
+        }
+        assert!(coefficients.iter().all(|c| *c == zero), "{claim}");
+        assert_eq!(constant, value, "{claim}");
+        assert!(value <= zero, "{claim}");
+        checked += 1;
+    }
+    assert!(
+        checked > 0 && integer_multipliers > 0,
+        "{checked} {integer_multipliers}"
+    );
+}
+
+/// When balance fixes a spring's anchor `a = a₀` (K42 alone: a = (1/4, 0), see tests/palletizer.rs;
+/// K53 mirrors it with (−1/4, 0)), a physical spring has `W = a₀ βᵀ`. Those four equations are
+/// written here by variable name (`K42·ax·by − a₀x·K42·by = 0`, …) and solved with the variant's
+/// balance equations: the mass of m7 they force is the one the search's reason quotes, and it is
+/// negative, so the pair is unrealizable.
+#[test]
+fn a_fixed_anchor_restricts_the_spring_as_written_by_hand() {
+    let model = model_of(&palletizer_json());
+    let energy = mechanism_energy(&model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+    let basis = LiftedBasis::build(&energy, &catalogue);
+    let exact = basis.exact.as_ref().expect("exact case");
+    let report = run(&model, 2);
+    let q = |n: i64, d: i64| Rational::new(n.into(), d.into());
+    for (spring, a0) in [("K42", [q(1, 4), q(0, 1)]), ("K53", [q(-1, 4), q(0, 1)])] {
+        let v = find(&report, &[spring, "m7"]);
+        let set: Vec<usize> = v.elements.iter().map(|e| e.entry).collect();
+        let names: Vec<&str> = set
+            .iter()
+            .flat_map(|&e| catalogue.entries[e].variables.iter().map(String::as_str))
+            .collect();
+        let column = |name: String| names.iter().position(|n| *n == name).unwrap();
+        let mut rows = Vec::new();
+        for (i, ai) in ["x", "y"].iter().zip(&a0) {
+            for j in ["x", "y"] {
+                let mut row = vec![q(0, 1); names.len()];
+                row[column(format!("{spring}·a{i}·b{j}"))] = q(1, 1);
+                row[column(format!("{spring}·b{j}"))] = -ai.clone();
+                rows.push(row);
+            }
+        }
+        let restricted = exact.solve_with(&set, &rows);
+        assert!(restricted.consistent(), "{spring}");
+        let mass = column("m7".to_string());
+        assert!(restricted.is_fixed(mass), "{spring}");
+        let m7 = &restricted.particular[mass];
+        assert!(*m7 < q(0, 1), "{spring}: m7 = {m7}");
+        assert_eq!(v.status, Status::Unrealizable);
+        let anchor: Vec<String> = a0.iter().map(exact_text).collect();
+        assert_eq!(
+            v.reason.as_deref(),
+            Some(
+                format!(
+                    "with {spring}'s anchor a = ({}) fixed by balance, m7: balance forces its \
+                     mass to {} kg",
+                    anchor.join(", "),
+                    exact_text(m7)
+                )
+                .as_str()
+            ),
+        );
+    }
 }

@@ -5,8 +5,8 @@ mod common;
 use common::{find, palletizer, run};
 use counterpoise_balance::verify::element_energy;
 use counterpoise_balance::{
-    Attachment, CounterweightParams, Decision, MechanismEnergy, SpringParams, Status, Witness,
-    mechanism_energy,
+    Attachment, Class, CounterweightParams, Decision, MechanismEnergy, SpringParams, Status,
+    Witness, mechanism_energy,
 };
 use counterpoise_model::Model;
 use counterpoise_model::sampling::SplitMix64;
@@ -289,4 +289,43 @@ fn results_do_not_depend_on_the_thread_count() {
         serde_json::to_string(&report.variants).unwrap()
     };
     assert_eq!(in_pool(1), in_pool(2));
+}
+
+/// Classes by counting (paper Eqs. A6–A8, L = 7, no base springs): 7 counterweights and
+/// C(7, 2) = 21 springs give, at Dmax 2, C(7,1) + C(7,2) = 28 counterweight-only variants,
+/// C(21,1) + C(21,2) = 231 spring-only ones and 7·21 = 147 hybrids (28 + 231 + 147 = 406).
+#[test]
+fn variant_classes_and_per_class_counts_follow_the_combinatorics() {
+    let report = run(&palletizer(), 2);
+    assert_eq!(report.catalogue.counts(), (7, 21));
+    let expected = [
+        (Class::Counterweights, 28),
+        (Class::Springs, 231),
+        (Class::Hybrid, 147),
+    ];
+    for (class, count) in expected {
+        let members = report.variants.iter().filter(|v| v.class == class).count();
+        assert_eq!(members, count, "{class:?}");
+        // The per-status counts of a class add up to the class, whatever the verdicts.
+        let by_status: usize = Status::ALL
+            .iter()
+            .map(|&s| report.count_class(s, class))
+            .sum();
+        assert_eq!(by_status, count, "{class:?}");
+    }
+    // And the per-class counts of a status add up to that status's count (pinned, for these
+    // verdicts, against an independent exact computation in tests/exact_decision.rs).
+    for status in Status::ALL {
+        let by_class: usize = expected
+            .iter()
+            .map(|&(c, _)| report.count_class(status, c))
+            .sum();
+        assert_eq!(by_class, report.count(status), "{status:?}");
+    }
+    // One variant of each class, named by hand.
+    assert_eq!(find(&report, &["m4", "m5"]).class, Class::Counterweights);
+    assert_eq!(find(&report, &["K43", "K53"]).class, Class::Springs);
+    assert_eq!(find(&report, &["m4", "K43"]).class, Class::Hybrid);
+    assert_eq!(find(&report, &["m4"]).class, Class::Counterweights);
+    assert_eq!(find(&report, &["K43"]).class, Class::Springs);
 }

@@ -287,6 +287,53 @@ mod tests {
     }
 
     #[test]
+    fn relations_read_off_the_reduced_rows() {
+        // The system of the test above, reduced by hand: y − z = 1/2 and x + 2y + 3z = 6 give
+        // x + 5z = 5. Only the free column z appears, never the pivot itself or a zero entry.
+        let e = eliminate(&big(&[&[1, 2, 3, 6], &[2, 4, 6, 12], &[0, 2, -2, 1]]), 3);
+        assert_eq!(
+            e.relations(),
+            vec![
+                (0, vec![(2, q(5, 1))], q(5, 1)),
+                (1, vec![(2, q(-1, 1))], q(1, 2)),
+            ]
+        );
+        // A full-rank system has no free terms: x = 9/5, y = 3/5 (solved by hand below).
+        let full = eliminate(&big(&[&[2, 4, 6], &[-3, 9, 0]]), 2);
+        assert_eq!(
+            full.relations(),
+            vec![(0, vec![], q(9, 5)), (1, vec![], q(3, 5))]
+        );
+    }
+
+    /// The i128 and the big-integer arithmetic must reach the same reduced rows (the fallback is
+    /// only for overflow): the same elimination run in both rings is a second computation.
+    #[test]
+    fn both_arithmetics_give_the_same_reduced_rows() {
+        let systems: [&[&[i64]]; 4] = [
+            &[&[2, 4, 6], &[-3, 9, 0]],
+            &[&[-2, 4, 6]],
+            &[&[1, 2, 3, 6], &[2, 4, 6, 12], &[0, 2, -2, 1]],
+            &[&[0, -6, 4, 2], &[0, 9, -6, 1], &[-4, 2, 0, 8]],
+        ];
+        for rows in systems {
+            let rows = big(rows);
+            let columns = rows[0].len() - 1;
+            let small = eliminate_small(&rows, columns).expect("small numbers stay in i128");
+            let big = gauss_jordan(rows.clone(), columns).expect("no overflow");
+            assert_eq!(small, big, "{rows:?}");
+        }
+        // By hand for the last one: −6y + 4z = 2 and 9y − 6z = 1 are 3y − 2z = −1 and
+        // 3y − 2z = 1/9: inconsistent; the pivots are x (from −4x + 2y = 8) and y.
+        let last = gauss_jordan(big(&[&[0, -6, 4, 2], &[0, 9, -6, 1], &[-4, 2, 0, 8]]), 3).unwrap();
+        assert!(!last.consistent);
+        assert_eq!(last.pivots, vec![0, 1]);
+        // Every reduced row is primitive with a positive pivot, in the big ring too.
+        let flipped = gauss_jordan(big(&[&[-2, 4, 6]]), 2).unwrap();
+        assert_eq!(flipped.rows, big(&[&[1, -2, -3]]));
+    }
+
+    #[test]
     fn rows_end_in_lowest_terms_with_positive_pivots_on_the_small_path() {
         // 2x + 4y = 6 and −3x + 9y = 0: solved in i128, each row divided by its content.
         let rows = big(&[&[2, 4, 6], &[-3, 9, 0]]);

@@ -305,3 +305,58 @@ pub fn exact_text(q: &Rational) -> String {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ints(v: &[i64]) -> Vec<BigInt> {
+        v.iter().map(|&x| BigInt::from(x)).collect()
+    }
+
+    fn q(n: i64, d: i64) -> Rational {
+        Rational::new(BigInt::from(n), BigInt::from(d))
+    }
+
+    /// A basis written by hand: `unbalanced[r]` is `b` on row `r`, `columns[e][j][r]` the
+    /// coefficient of element `e`'s variable `j`. Solving means `Σ columns·x = −b` row by row.
+    fn basis(unbalanced: &[i64], columns: &[&[&[i64]]]) -> ExactBasis {
+        let rows = unbalanced.len();
+        ExactBasis {
+            monomials: (0..rows).map(Monomial::sine).collect(),
+            unbalanced: ints(unbalanced),
+            elements: columns
+                .iter()
+                .map(|e| e.iter().map(|c| ints(c)).collect())
+                .collect(),
+            row_factors: vec![q(1, 1); rows],
+        }
+    }
+
+    #[test]
+    fn a_row_without_unbalanced_energy_still_constrains_the_variant() {
+        // By hand: x = 2 (row 0: x = −(−2)) and x = 0 (row 1, where b is zero) contradict.
+        let b = basis(&[-2, 0], &[&[&[1, 1]]]);
+        assert!(!b.solve(&[0]).consistent());
+        // Without the second row's coefficient the variant balances with x = 2.
+        let b = basis(&[-2, 0], &[&[&[1, 0]]]);
+        let s = b.solve(&[0]);
+        assert!(s.consistent());
+        assert_eq!(s.particular, vec![q(2, 1)]);
+    }
+
+    #[test]
+    fn an_anchor_is_proportional_to_a_fixed_stiffness() {
+        // Variables (K, αx, αy) with K = 3, 4·αx = 3, αy = 0: by hand α = (3/4, 0) = (1/4, 0)·K.
+        let b = basis(&[-3, -3, 0], &[&[&[1, 0, 0], &[0, 4, 0], &[0, 0, 1]]]);
+        let s = b.solve(&[0]);
+        assert!(s.is_fixed(0) && s.fixed_positive(0));
+        assert_eq!(s.proportional_to(0, 1..3), Some(vec![q(1, 4), q(0, 1)]));
+        // αx left free (no equation on it): αx is not a fixed multiple of the fixed K.
+        let free = basis(&[-3, 0], &[&[&[1, 0], &[0, 0], &[0, 1]]]);
+        assert_eq!(free.solve(&[0]).proportional_to(0, 1..3), None);
+        // K forced to zero: α = a₀·K says nothing about a₀, so there is no anchor.
+        let zero = basis(&[0, -3, 0], &[&[&[1, 0, 0], &[0, 4, 0], &[0, 0, 1]]]);
+        assert_eq!(zero.solve(&[0]).proportional_to(0, 1..3), None);
+    }
+}

@@ -293,6 +293,70 @@ mod tests {
         assert_eq!(half_line.high, None);
     }
 
+    fn open(n: i64, d: i64) -> Option<Bound> {
+        Some(Bound {
+            value: Rational::new(BigInt::from(n), BigInt::from(d)),
+            closed: false,
+        })
+    }
+
+    #[test]
+    fn the_certificate_carries_non_unit_multipliers() {
+        // By hand: 2z − 1 > 0 needs z > 1/2 and 1 − 3z > 0 needs z < 1/3. Cancelling z takes
+        // 3·(2z − 1) + 2·(1 − 3z) = −1 ≤ 0, so the multipliers are (3, 2) and the value −1.
+        let err = strictly_feasible(&[affine(-1, &[2]), affine(1, &[-3])]).unwrap_err();
+        assert_eq!(err.multipliers, vec![q(3), q(2)]);
+        assert_eq!(err.value, q(-1));
+        // With z < 1 instead the interval (1/2, 1) is not empty.
+        assert!(strictly_feasible(&[affine(-1, &[2]), affine(1, &[-1])]).is_ok());
+    }
+
+    #[test]
+    fn the_tightest_of_several_bounds_wins_in_any_order() {
+        // z > 1, z > 3, z < 7, z < 10: by hand the range of z is (3, 7). The tighter lower bound
+        // comes second, the tighter upper bound first, and the other way round.
+        let constraints = [
+            affine(-1, &[1]),
+            affine(-3, &[1]),
+            affine(7, &[-1]),
+            affine(10, &[-1]),
+        ];
+        let z = affine(0, &[1]);
+        for order in [[0, 1, 2, 3], [1, 0, 3, 2]] {
+            let reordered: Vec<Affine> = order.iter().map(|&i| constraints[i].clone()).collect();
+            let r = range(&reordered, &z).unwrap();
+            assert_eq!((r.low, r.high), (open(3, 1), open(7, 1)), "{order:?}");
+        }
+        // Equal bounds twice: still the open interval (3, 7).
+        let twice = [affine(-3, &[1]), affine(-3, &[1]), affine(7, &[-1])];
+        let r = range(&twice, &z).unwrap();
+        assert_eq!((r.low, r.high), (open(3, 1), open(7, 1)));
+    }
+
+    #[test]
+    fn a_target_with_several_coefficients_ranges_between_the_vertex_values() {
+        // The open triangle z1 > 0, z2 > 0, z1 + z2 < 4 has vertices (0,0), (4,0), (0,4); the
+        // affine target 1 + 2 z1 + z2 takes 1, 9 and 5 there, so its range is (1, 9). The same
+        // with 5 − z1 + 3 z2 (pivot on a negative coefficient): 5, 1 and 17, range (1, 17).
+        let triangle = [affine(0, &[1, 0]), affine(0, &[0, 1]), affine(4, &[-1, -1])];
+        let r = range(&triangle, &affine(1, &[2, 1])).unwrap();
+        assert_eq!((r.low, r.high), (open(1, 1), open(9, 1)));
+        let r = range(&triangle, &affine(5, &[-1, 3])).unwrap();
+        assert_eq!((r.low, r.high), (open(1, 1), open(17, 1)));
+        // Scaled so the pivot ratio is a fraction: 3·z1 over the triangle ranges over (0, 12).
+        let r = range(&triangle, &affine(0, &[3, 0])).unwrap();
+        assert_eq!((r.low, r.high), (open(0, 1), open(12, 1)));
+        // A constant target is its own range, closed, when the constraints are feasible...
+        let r = range(&triangle, &affine(2, &[0, 0])).unwrap();
+        let two = Some(Bound {
+            value: q(2),
+            closed: true,
+        });
+        assert_eq!((r.low, r.high), (two.clone(), two));
+        // ...and an error when they are not.
+        assert!(range(&[affine(-1, &[0])], &affine(2, &[0])).is_err());
+    }
+
     #[test]
     fn a_fixed_negative_mass_is_infeasible() {
         let err = strictly_feasible(&[affine(-3, &[])]).unwrap_err();

@@ -200,3 +200,164 @@ pub fn contradiction(
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::element::Attachment;
+    use counterpoise_symbolic::Monomial;
+    use num_bigint::BigInt;
+
+    fn spring() -> CatalogueEntry {
+        CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0, 1],
+                axes_b: vec![0, 1],
+            },
+            label: "K1".into(),
+            description: "spring".into(),
+            variables: Vec::new(),
+            energy: Vec::new(),
+        }
+    }
+
+    fn counterweight() -> CatalogueEntry {
+        CatalogueEntry {
+            element: Element::Counterweight {
+                body: 0,
+                axes: vec![0, 1],
+            },
+            label: "m1".into(),
+            description: "counterweight".into(),
+            variables: Vec::new(),
+            energy: Vec::new(),
+        }
+    }
+
+    /// Counterweight `(m, m·rx, m·ry)` and spring `(K, αx, αy, βx, βy, Wxx, Wxy, Wyx, Wyy)` with
+    /// the balance rows `m + s·K = c` (`s = ±1`), `α = (2, 1)`, `β = (3, 2)` and `w·Wxx = 6`
+    /// (scaled by `factor` from the physical row). By hand, `K·Wxx = αx·βx` forces
+    /// `K = 2·3/(6/w) = w`, and positive heads allow `K < c` (`s = 1`) or `K > −c` (`s = −1`).
+    fn decide(s: i64, c: i64, w: i64, factor: i64) -> Option<String> {
+        // (column of the variant, coefficient) per row, and the row's right-hand side.
+        let rows: [(&[(usize, i64)], i64); 6] = [
+            (&[(0, 1), (3, s)], c),
+            (&[(4, 1)], 2),
+            (&[(5, 1)], 1),
+            (&[(6, 1)], 3),
+            (&[(7, 1)], 2),
+            (&[(8, w)], 6),
+        ];
+        let column = |j: usize| -> Vec<BigInt> {
+            rows.iter()
+                .map(|(terms, _)| {
+                    let c = terms.iter().find(|(k, _)| *k == j).map_or(0, |&(_, v)| v);
+                    BigInt::from(c)
+                })
+                .collect()
+        };
+        let mut row_factors = vec![Rational::from_integer(1.into()); rows.len()];
+        row_factors[5] = Rational::from_integer(factor.into());
+        let basis = ExactBasis {
+            monomials: (0..rows.len()).map(Monomial::sine).collect(),
+            unbalanced: rows.iter().map(|&(_, v)| BigInt::from(-v)).collect(),
+            elements: vec![(0..3).map(column).collect(), (3..12).map(column).collect()],
+            row_factors,
+        };
+        let solution = basis.solve(&[0, 1]);
+        assert!(solution.consistent());
+        contradiction(&basis, &solution, &[&counterweight(), &spring()])
+    }
+
+    /// A lone one-axis spring `(K, α, β, W)` with balance rows `Σ coefficient·x = rhs`.
+    fn lone_spring(rows: &[(&[(usize, i64)], i64)]) -> Option<String> {
+        let column = |j: usize| -> Vec<BigInt> {
+            rows.iter()
+                .map(|(terms, _)| {
+                    let c = terms.iter().find(|(k, _)| *k == j).map_or(0, |&(_, v)| v);
+                    BigInt::from(c)
+                })
+                .collect()
+        };
+        let basis = ExactBasis {
+            monomials: (0..rows.len()).map(Monomial::sine).collect(),
+            unbalanced: rows.iter().map(|&(_, v)| BigInt::from(-v)).collect(),
+            elements: vec![(0..4).map(column).collect()],
+            row_factors: vec![Rational::from_integer(1.into()); rows.len()],
+        };
+        let solution = basis.solve(&[0]);
+        assert!(solution.consistent());
+        let entry = CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0],
+                axes_b: vec![0],
+            },
+            ..spring()
+        };
+        contradiction(&basis, &solution, &[&entry])
+    }
+
+    #[test]
+    fn a_quadratic_residual_proves_nothing_unless_its_square_terms_cancel() {
+        // K = 1 and W = 1 fixed, α = z1 and β = z2 free: K·W − α·β = 1 − z1·z2 is zero on the
+        // hyperbola z1·z2 = 1 (a = b = 1 is a spring), so there is no proof.
+        assert_eq!(lone_spring(&[(&[(0, 1)], 1), (&[(3, 1)], 1)]), None);
+        // K = z, α = β = 2z, W = 4z + 1: K·W − α·β = 4z² + z − 4z² = z, zero only at K = 0.
+        assert_eq!(
+            lone_spring(&[
+                (&[(3, 1), (0, -4)], 1),
+                (&[(1, 1), (0, -2)], 0),
+                (&[(2, 1), (0, -2)], 0),
+            ]),
+            Some(
+                "K1: no spring has the anchors balance requires (K·W − α·βᵀ = 1·K on every \
+                 solution, zero only at K = 0 N/m)"
+                    .to_string()
+            )
+        );
+        // K = 1, W = 4, α = β = z: K·W − α·β = 4 − z², zero at z = ±2 (a = b = 2): no proof.
+        assert_eq!(
+            lone_spring(&[(&[(0, 1)], 1), (&[(3, 1)], 4), (&[(1, 1), (2, -1)], 0)]),
+            None
+        );
+    }
+
+    #[test]
+    fn a_stiffness_with_a_constant_part_demands_the_hand_computed_value() {
+        // W = 4, β = 3 and K − α = 1 (K = 1 + z, α = z): K·W − α·β = 4K − 3(K − 1) = K + 3,
+        // zero only at K = −3: no positive spring.
+        assert_eq!(
+            lone_spring(&[(&[(3, 1)], 4), (&[(2, 1)], 3), (&[(0, 1), (1, -1)], 1)]),
+            Some(
+                "K1: no spring has the anchors balance requires (K·W − α·βᵀ = 3 + 1·K on every \
+                 solution, zero only at K = -3 N/m)"
+                    .to_string()
+            )
+        );
+    }
+
+    #[test]
+    fn a_forced_stiffness_outside_the_positive_range_is_a_contradiction() {
+        let outside = |form: &str, k: i64| {
+            Some(format!(
+                "K1: no spring has the anchors balance requires ({form} on every solution, zero \
+                 only at K = {k} N/m, outside what positive masses and stiffnesses allow)"
+            ))
+        };
+        // w = 6: Wxx = 1, residual of the Wxx row 6·(K·1 − 6) = −36 + 6·K, zero at K = 6; but
+        // m = 5 − K > 0 needs K < 5.
+        assert_eq!(decide(1, 5, 6, 1), outside("K·W − α·βᵀ = -36 + 6·K", 6));
+        // m = K − 7 > 0 needs K > 7: K = 6 is below.
+        assert_eq!(decide(-1, -7, 6, 1), outside("K·W − α·βᵀ = -36 + 6·K", 6));
+        // 5·(K·6/5 − 6) = 6K − 30, in physical units (row factor 2) −15 + 3·K: K = 5 is the open
+        // end of K < 5, which positive masses never reach.
+        assert_eq!(decide(1, 5, 5, 2), outside("K·W − α·βᵀ = -15 + 3·K", 5));
+        // K = 4 inside (0, 5) and K = 8 inside (7, ∞): a spring may exist, no proof.
+        assert_eq!(decide(1, 5, 4, 1), None);
+        assert_eq!(decide(-1, -7, 8, 1), None);
+    }
+}
