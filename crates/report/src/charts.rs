@@ -530,7 +530,7 @@ mod tests {
         assert!(sizes(0).is_empty());
         for n in 2..=48 {
             assert!(
-                sizes(n).iter().all(|&k| k >= 2 && k <= BARS_PER_CHART),
+                sizes(n).iter().all(|k| (2..=BARS_PER_CHART).contains(k)),
                 "{n}"
             );
             assert_eq!(sizes(n).iter().sum::<usize>(), n);
