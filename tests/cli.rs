@@ -307,7 +307,11 @@ fn a_zero_length_task_is_named_as_such() {
     ]);
     assert_eq!(out.status.code(), Some(1));
     let err = stderr(&out);
-    assert!(err.contains("task (1, 1) is a zero-length move"), "{err}");
+    assert!(
+        err.contains("error: task 1→1 is a zero-length move"),
+        "{err}"
+    );
+    assert_eq!(err.matches("1→1").count(), 1, "named once: {err}");
     // The pendulum's grid has 5 points: index 5 is out of range, and the message says so.
     let out = counterpoise(&[
         "evaluate",

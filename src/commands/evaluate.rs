@@ -4,8 +4,10 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Context, Result, bail};
-use counterpoise_dynamics::{EvaluateOptions, EvaluationReport, evaluate, task_series};
+use anyhow::{Result, bail};
+use counterpoise_dynamics::{
+    DynamicsError, EvaluateOptions, EvaluationReport, evaluate, task_series,
+};
 
 /// Options of the command.
 pub struct Options<'a> {
@@ -30,8 +32,13 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
         return Ok(ExitCode::FAILURE);
     }
     if let Some(((i, j), file)) = options.series {
-        let series =
-            task_series(&model, i, j, options.samples).with_context(|| format!("task {i}→{j}"))?;
+        let series = task_series(&model, i, j, options.samples).map_err(|e| match e {
+            // These name the task already.
+            DynamicsError::ZeroLengthTask { .. } | DynamicsError::NoSuchTask { .. } => {
+                anyhow::Error::new(e)
+            }
+            e => anyhow::Error::new(e).context(format!("task {i}→{j}")),
+        })?;
         let text = serde_json::to_string_pretty(&series)?;
         super::write_atomic(file, text.as_bytes())?;
         eprintln!("wrote the series of task {i}→{j} to {}", file.display());

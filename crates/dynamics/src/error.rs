@@ -64,9 +64,9 @@ pub enum DynamicsError {
     NoTasks,
     #[error("task grid: {0}")]
     BadGrid(String),
-    #[error("task ({i}, {j}) does not exist: the grid has {points} points (indices 0 to {last})", last = points.saturating_sub(1))]
+    #[error("task {i}→{j} does not exist: the grid has {points} points (indices 0 to {last})", last = points.saturating_sub(1))]
     NoSuchTask { i: usize, j: usize, points: usize },
-    #[error("task ({i}, {i}) is a zero-length move: a task goes from one grid point to another")]
+    #[error("task {i}→{i} is a zero-length move: a task goes from one grid point to another")]
     ZeroLengthTask { i: usize },
     #[error("parameter set: {0}")]
     BadParameters(String),

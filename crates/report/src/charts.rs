@@ -514,6 +514,30 @@ mod tests {
     use super::*;
 
     #[test]
+    fn long_classes_split_into_charts_of_about_equal_size() {
+        let sizes = |n: usize| -> Vec<usize> {
+            let items: Vec<usize> = (0..n).collect();
+            even_chunks(&items, BARS_PER_CHART)
+                .iter()
+                .map(|c| c.len())
+                .collect()
+        };
+        // 33 = 16 + 16 + 1 would leave a lone bar ("class ranks 33–33 of 33")
+        assert_eq!(sizes(33), vec![11, 11, 11]);
+        assert_eq!(sizes(17), vec![9, 8]);
+        assert_eq!(sizes(16), vec![16]);
+        assert_eq!(sizes(2), vec![2]);
+        assert!(sizes(0).is_empty());
+        for n in 2..=48 {
+            assert!(
+                sizes(n).iter().all(|k| (2..=BARS_PER_CHART).contains(k)),
+                "{n}"
+            );
+            assert_eq!(sizes(n).iter().sum::<usize>(), n);
+        }
+    }
+
+    #[test]
     fn critical_reasons_are_grouped() {
         let r = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
         assert_eq!(
