@@ -396,14 +396,37 @@ fn a_case_without_bounds_gets_bounds_from_the_mechanism() {
 fn progress_is_one_line_per_phase_off_a_terminal_and_quiet_silences_it() {
     let dir = tempfile::tempdir().unwrap();
     let (o, _) = run_pendulum(dir.path(), "loud", &[]);
-    let lines: Vec<String> = stderr(&o)
+    let all: Vec<String> = stderr(&o)
         .lines()
         .filter(|l| l.starts_with('['))
         .map(str::to_string)
         .collect();
+    // One line as each phase starts, and within the optimisation one as each of its stages
+    // starts, with how many variants it has to do.
+    let (stages, lines): (Vec<String>, Vec<String>) =
+        all.into_iter().partition(|l| l.contains(" to do ("));
     assert_eq!(lines.len(), 4, "{lines:?}");
     assert!(lines[0].starts_with("[1/4] Phase 1: unbalanced robot over all tasks (elapsed "));
     assert!(lines[3].starts_with("[4/4] Phase 3: ranking"), "{lines:?}");
+    let optimisation = "[3/4] Phase 2: optimisation of the 2 balanced variants: ";
+    assert!(lines[2].starts_with(&optimisation[..optimisation.len() - 2]));
+    assert!(
+        stages[0].starts_with(&format!("{optimisation}critical-task pass 1, 2 to do")),
+        "{stages:?}"
+    );
+    assert!(
+        stages.iter().all(|l| l.starts_with(optimisation)),
+        "{stages:?}"
+    );
+    let last_two: Vec<&str> = stages[stages.len() - 2..]
+        .iter()
+        .map(|l| l[optimisation.len()..].split(',').next().unwrap())
+        .collect();
+    assert_eq!(
+        last_two,
+        ["spring choice", "final evaluation"],
+        "{stages:?}"
+    );
     let (o, _) = run_pendulum(dir.path(), "quiet", &["--quiet"]);
     assert_eq!(stderr(&o), "");
     assert!(stdout(&o).contains("wrote "));

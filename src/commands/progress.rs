@@ -6,8 +6,9 @@
 //!   time elapsed so far, so a 30 s run is never silent and the log is not full of redraws.
 //! - `--quiet`: nothing.
 //!
-//! The dynamics and the optimiser report no progress of their own, so a phase shows its
-//! number among the phases and the time elapsed, not a count of variants.
+//! A phase that reports its own progress (the optimisation: `critical-task pass 1: 312/1169`)
+//! shows it as well: on a terminal the live line carries the stage, the count and an estimate
+//! of the time left in the stage; in lines mode one line is printed as each stage starts.
 
 use std::io::IsTerminal;
 use std::time::{Duration, Instant};
@@ -75,6 +76,8 @@ impl Progress {
             bar,
             label,
             started: Instant::now(),
+            mode: self.mode,
+            stage: std::sync::Mutex::new(None),
         }
     }
 }
@@ -84,9 +87,40 @@ pub struct Phase {
     bar: Option<ProgressBar>,
     label: String,
     started: Instant,
+    mode: Mode,
+    /// The stage being counted and when it started (for the estimate of the time left).
+    stage: std::sync::Mutex<Option<(String, Instant)>>,
+}
+
+/// The estimated time left when `done` of `total` items took `elapsed`: `None` before the
+/// first item (nothing to extrapolate from).
+pub fn time_left(elapsed: Duration, done: usize, total: usize) -> Option<Duration> {
+    (done > 0 && done <= total).then(|| elapsed.mul_f64((total - done) as f64 / done as f64))
 }
 
 impl Phase {
+    /// The phase's work reached `done` of `total` items of `stage` (called from any thread).
+    pub fn report(&self, stage: &str, done: usize, total: usize) {
+        let mut current = self.stage.lock().expect("progress lock");
+        let new_stage = current.as_ref().is_none_or(|(s, _)| s != stage);
+        if new_stage {
+            *current = Some((stage.to_string(), Instant::now()));
+            if self.mode == Mode::Lines {
+                eprintln!(
+                    "{}: {stage}, {total} to do ({:.1} s into the phase)",
+                    self.label,
+                    self.started.elapsed().as_secs_f64()
+                );
+            }
+        }
+        if let (Some(bar), Some((_, since))) = (&self.bar, current.as_ref()) {
+            let left = time_left(since.elapsed(), done, total).map_or(String::new(), |t| {
+                format!(", about {:.0} s left", t.as_secs_f64())
+            });
+            bar.set_message(format!("{} — {stage}: {done}/{total}{left}", self.label));
+        }
+    }
+
     /// Ends the phase; on a terminal its line stays with the time it took.
     pub fn finish(self) {
         if let Some(bar) = self.bar {
@@ -97,5 +131,24 @@ impl Phase {
                 self.started.elapsed().as_secs_f64()
             ));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_left_extrapolates_the_rate_so_far() {
+        // 25 of 100 in 10 s: 75 more at the same rate take 30 s.
+        assert_eq!(
+            time_left(Duration::from_secs(10), 25, 100),
+            Some(Duration::from_secs(30))
+        );
+        assert_eq!(time_left(Duration::from_secs(10), 0, 100), None);
+        assert_eq!(
+            time_left(Duration::from_secs(10), 100, 100),
+            Some(Duration::ZERO)
+        );
     }
 }

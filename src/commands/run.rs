@@ -15,7 +15,9 @@ use counterpoise_dynamics::{
     Counterweight, EvaluateOptions, Indicators, Spring, Variant, evaluate_grid, task_series_with,
 };
 use counterpoise_model::Model;
-use counterpoise_optimise::{Context, Objective, OptimiseOptions, OptimisedVariant, optimise_all};
+use counterpoise_optimise::{
+    Context, Objective, OptimiseOptions, OptimisedVariant, optimise_all_reporting,
+};
 use counterpoise_report as report;
 use report::{
     ActuatorSummary, ElementInfo, ElementKind, Evaluation, FreeDirection, JointPeak, OptimiserInfo,
@@ -43,9 +45,18 @@ struct Timer {
 
 impl Timer {
     fn time<T>(&mut self, name: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
+        self.time_reporting(name, |_| work())
+    }
+
+    /// [`Timer::time`] for work that reports its own progress to the phase.
+    fn time_reporting<T>(
+        &mut self,
+        name: &str,
+        work: impl FnOnce(&super::progress::Phase) -> Result<T>,
+    ) -> Result<T> {
         let phase = self.progress.phase(name);
         let started = Instant::now();
-        let out = work();
+        let out = work(&phase);
         let seconds = started.elapsed().as_secs_f64();
         phase.finish();
         self.timings.push(PhaseTiming {
@@ -130,7 +141,7 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
         .filter(|v| v.status == Status::Balanced)
         .count();
     let phase_name = format!("Phase 2: optimisation of the {balanced_count} balanced variants");
-    let optimised = timer.time(&phase_name, || {
+    let optimised = timer.time_reporting(&phase_name, |phase| {
         let context = Context::new(&model, Some(unbalanced.clone()))?;
         let settings = OptimiseOptions {
             objective: if options.minimax {
@@ -140,7 +151,17 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
             },
             ..OptimiseOptions::default()
         };
-        Ok(optimise_all(&context, &found.variants, &settings))
+        let report = |p: counterpoise_optimise::StageProgress| {
+            let stage = if p.stage == "critical-task pass" {
+                format!("{} {}", p.stage, p.pass)
+            } else if p.pass > 0 {
+                format!("{} (pass {})", p.stage, p.pass)
+            } else {
+                p.stage.to_string()
+            };
+            phase.report(&stage, p.done, p.total);
+        };
+        Ok(optimise_all_reporting(&context, &found.variants, &settings, &report).0)
     })?;
 
     // Phase 3: ranking and reports.

@@ -25,6 +25,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::context::Context;
 use crate::problem::{CwPhysical, Objective, VariantProblem};
+use crate::progress::{ProgressSink, StageCounter};
 use crate::refine::{
     FEASIBILITY_TOL, counterweight_directions, merit, project_fixed, project_radius, refine,
 };
@@ -165,6 +166,16 @@ pub fn optimise_all_timed(
     variants: &[VariantResult],
     options: &OptimiseOptions,
 ) -> (Vec<OptimisedVariant>, StageTimings) {
+    optimise_all_reporting(ctx, variants, options, &crate::progress::silent)
+}
+
+/// [`optimise_all_timed`] that reports its progress to `progress` as variants finish each stage.
+pub fn optimise_all_reporting(
+    ctx: &Context,
+    variants: &[VariantResult],
+    options: &OptimiseOptions,
+    progress: ProgressSink<'_>,
+) -> (Vec<OptimisedVariant>, StageTimings) {
     let mut timings = StageTimings::default();
     let mut runs: Vec<Run> = variants
         .iter()
@@ -190,9 +201,15 @@ pub fn optimise_all_timed(
         let (_, failures) = ctx.torques.get(&ctx.model, &ctx.tasks, &union);
         let failed: BTreeSet<usize> = failures.iter().map(|f| f.0).collect();
 
+        let counter =
+            StageCounter::start(progress, "critical-task pass", timings.passes, active.len());
         let outcomes: Vec<(usize, Result<Candidate, Failure>)> = active
             .par_iter()
-            .map(|&k| (k, step(ctx, &runs[k], &failed, options)))
+            .map(|&k| {
+                let outcome = step(ctx, &runs[k], &failed, options);
+                counter.tick();
+                (k, outcome)
+            })
             .collect();
         timings.solve += started.elapsed();
         let started = Stopwatch::start();
@@ -209,6 +226,12 @@ pub fn optimise_all_timed(
         if evaluated.is_empty() {
             continue;
         }
+        StageCounter::start(
+            progress,
+            "all-task evaluation",
+            timings.passes,
+            evaluated.len(),
+        );
         let dyn_variants = candidate_variants(&runs, &evaluated);
         let indicators = grid_indicators(ctx, &dyn_variants, false);
         timings.loop_grid += started.elapsed();
@@ -254,7 +277,7 @@ pub fn optimise_all_timed(
             run.state = State::Stopped;
         }
     }
-    let out = finish(ctx, runs, options, &mut timings);
+    let out = finish(ctx, runs, options, &mut timings, progress);
     (out, timings)
 }
 
@@ -784,6 +807,7 @@ fn finish(
     mut runs: Vec<Run>,
     options: &OptimiseOptions,
     timings: &mut StageTimings,
+    progress: ProgressSink<'_>,
 ) -> Vec<OptimisedVariant> {
     let started = Stopwatch::start();
     // Reaction tasks: the critical tasks plus the unbalanced joints' critical tasks.
@@ -792,58 +816,13 @@ fn finish(
         joint_tasks.extend(ctx.task_index(j.force_task));
         joint_tasks.extend(ctx.task_index(j.moment_task));
     }
+    let counter = StageCounter::start(progress, "spring choice", 0, runs.len());
     let choices: Vec<Option<SpringChoice>> = runs
         .par_iter()
         .map(|run| {
-            let cand = run.candidate.as_ref()?;
-            if !matches!(run.state, State::Converged | State::Stopped) {
-                return None;
-            }
-            let problem = run.problem.as_ref()?;
-            if problem.springs.is_empty() {
-                return Some((Vec::new(), cand.x.clone(), None));
-            }
-            let (found, _) = realize_springs(
-                problem,
-                &ctx.basis.unbalanced,
-                &cand.x,
-                options.spring_starts * 4,
-                false,
-            );
-            let mut options_found: Vec<crate::springs::Realized> = found;
-            if options_found.is_empty() {
-                options_found.push((cand.springs.clone(), cand.x.clone()));
-            }
-            let variants: Vec<Variant> = options_found
-                .iter()
-                .map(|(s, _)| {
-                    dynamics_variant(
-                        problem,
-                        &Candidate {
-                            springs: s.clone(),
-                            ..cand.clone()
-                        },
-                    )
-                })
-                .collect();
-            let tasks: Vec<usize> = joint_tasks
-                .iter()
-                .copied()
-                .chain(run.working.iter().copied())
-                .collect::<BTreeSet<_>>()
-                .into_iter()
-                .collect();
-            let peaks = reaction_peaks(ctx, &variants, &tasks);
-            let scores: Vec<Option<f64>> = match &peaks {
-                Some(p) => p
-                    .iter()
-                    .map(|(f, m)| delta_r(&ctx.unbalanced, f, m))
-                    .collect(),
-                None => vec![None; variants.len()],
-            };
-            let best = lowest_delta_r(&scores).unwrap_or(0);
-            let (s, x) = options_found.swap_remove(best);
-            Some((s, x, scores[best]))
+            let choice = spring_choice(ctx, run, &joint_tasks, options);
+            counter.tick();
+            choice
         })
         .collect();
     for (run, choice) in runs.iter_mut().zip(&choices) {
@@ -861,6 +840,7 @@ fn finish(
                 && matches!(runs[k].state, State::Converged | State::Stopped)
         })
         .collect();
+    StageCounter::start(progress, "final evaluation", 0, finals.len());
     let variants = candidate_variants(&runs, &finals);
     let final_indicators = if variants.is_empty() {
         Ok(Vec::new())
@@ -885,6 +865,65 @@ fn finish(
         .collect();
     timings.records = started.elapsed();
     out
+}
+
+/// The spring option of one run with the lowest ΔR on the reaction tasks (`None` for a run
+/// without a candidate).
+fn spring_choice(
+    ctx: &Context,
+    run: &Run,
+    joint_tasks: &BTreeSet<usize>,
+    options: &OptimiseOptions,
+) -> Option<SpringChoice> {
+    let cand = run.candidate.as_ref()?;
+    if !matches!(run.state, State::Converged | State::Stopped) {
+        return None;
+    }
+    let problem = run.problem.as_ref()?;
+    if problem.springs.is_empty() {
+        return Some((Vec::new(), cand.x.clone(), None));
+    }
+    let (found, _) = realize_springs(
+        problem,
+        &ctx.basis.unbalanced,
+        &cand.x,
+        options.spring_starts * 4,
+        false,
+    );
+    let mut options_found: Vec<crate::springs::Realized> = found;
+    if options_found.is_empty() {
+        options_found.push((cand.springs.clone(), cand.x.clone()));
+    }
+    let variants: Vec<Variant> = options_found
+        .iter()
+        .map(|(s, _)| {
+            dynamics_variant(
+                problem,
+                &Candidate {
+                    springs: s.clone(),
+                    ..cand.clone()
+                },
+            )
+        })
+        .collect();
+    let tasks: Vec<usize> = joint_tasks
+        .iter()
+        .copied()
+        .chain(run.working.iter().copied())
+        .collect::<BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let peaks = reaction_peaks(ctx, &variants, &tasks);
+    let scores: Vec<Option<f64>> = match &peaks {
+        Some(p) => p
+            .iter()
+            .map(|(f, m)| delta_r(&ctx.unbalanced, f, m))
+            .collect(),
+        None => vec![None; variants.len()],
+    };
+    let best = lowest_delta_r(&scores).unwrap_or(0);
+    let (s, x) = options_found.swap_remove(best);
+    Some((s, x, scores[best]))
 }
 
 fn record(

@@ -29,6 +29,7 @@ pub mod diagnose;
 pub mod error;
 pub mod overrides;
 pub mod problem;
+pub mod progress;
 pub mod refine;
 pub mod relaxation;
 pub mod result;
@@ -41,11 +42,12 @@ pub use clarabel_map::ConicStatus;
 pub use context::Context;
 pub use critical::{
     OptimiseOptions, StageTimings, delta_r, lowest_delta_r, objective_of, optimise_all,
-    optimise_all_timed, optimise_variant,
+    optimise_all_reporting, optimise_all_timed, optimise_variant,
 };
 pub use error::OptimiseError;
 pub use overrides::{BoundsTable, CounterweightBounds, ElementBounds, SpringBounds};
 pub use problem::Objective;
+pub use progress::{ProgressSink, StageProgress};
 pub use result::{
     DisplayRow, FreeParameter, Iteration, OptimisedCounterweight, OptimisedSpring, OptimisedStatus,
     OptimisedVariant, display_rows,
