@@ -668,6 +668,29 @@ mod tests {
                 row(&[(8, 1)]),
             ]
         );
+        // The same with one axis per anchor, variables (K, αx, βx, Wxx) and βx = 3·K: b = (3),
+        // and the one row Wxx − 3αx = 0.
+        let mut columns = vec![int(&[0]); 4];
+        columns[0] = int(&[-3]);
+        columns[2] = int(&[1]);
+        let basis = ExactBasis {
+            monomials: vec![Monomial::sine(0)],
+            unbalanced: int(&[0]),
+            elements: vec![columns],
+            row_factors: vec![q(1)],
+        };
+        let entry = CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0],
+                axes_b: vec![0],
+            },
+            ..entry
+        };
+        let (anchors, rows) = fixed_anchor_equations(&basis.solve(&[0]), &[(0, &entry)]);
+        assert_eq!(anchors, vec!["K1's anchor b = (3)".to_string()]);
+        assert_eq!(rows, vec![vec![q(0), q(-3), q(0), q(1)]]);
     }
 
     /// A spring whose balance equations fix `α = (2, 1)`, `β = (3, 2)`, `Wxx = Wyy = 1` and leave

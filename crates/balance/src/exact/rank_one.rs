@@ -356,6 +356,8 @@ mod tests {
         // 5·(K·6/5 − 6) = 6K − 30, in physical units (row factor 2) −15 + 3·K: K = 5 is the open
         // end of K < 5, which positive masses never reach.
         assert_eq!(decide(1, 5, 5, 2), outside("K·W − α·βᵀ = -15 + 3·K", 5));
+        // 7·(K·6/7 − 6) = −42 + 6·K: K = 7 is the open end of K > 7.
+        assert_eq!(decide(-1, -7, 7, 1), outside("K·W − α·βᵀ = -42 + 6·K", 7));
         // K = 4 inside (0, 5) and K = 8 inside (7, ∞): a spring may exist, no proof.
         assert_eq!(decide(1, 5, 4, 1), None);
         assert_eq!(decide(-1, -7, 8, 1), None);
