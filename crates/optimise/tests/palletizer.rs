@@ -152,6 +152,32 @@ fn the_papers_eleven_sets() {
     }
 }
 
+/// The optimisation problem of the variant made of the catalogue entries `labels`.
+fn variant_problem(
+    ctx: &counterpoise_optimise::Context,
+    labels: &[&str],
+) -> counterpoise_optimise::problem::VariantProblem {
+    let set: Vec<usize> = labels
+        .iter()
+        .map(|l| {
+            ctx.catalogue
+                .entries
+                .iter()
+                .position(|e| &e.label == l)
+                .unwrap()
+        })
+        .collect();
+    counterpoise_optimise::problem::VariantProblem::new(
+        &ctx.model,
+        &ctx.catalogue,
+        &ctx.bounds,
+        &set,
+        counterpoise_balance::linear::solve(&ctx.basis, &set),
+        |b| ctx.torques.slot_of(b),
+    )
+    .unwrap()
+}
+
 /// `m4 + K42` balances only with K42's anchor a at x = 1/4 on the upper arm and b on the
 /// slider's y axis (relations `K42 − 4·K42·ax = 0`, `K42·ay = 0`, `K42·bx = 0`), so a physical
 /// spring has `K·ax·by = K·by/4` and `K·ax·bx = K·ay·by = 0`. The lifted family alone leaves
@@ -167,25 +193,7 @@ fn a_spring_whose_anchor_balance_fixes_is_realized_on_the_restricted_family() {
     let (ctx, results) = common::optimise(&model, &[&["m4", "K42"]], &OptimiseOptions::default());
     // The physical family is two-dimensional (K and K·by fix everything else), the lifted one
     // six-dimensional; the search runs on the restricted one.
-    let set: Vec<usize> = ["m4", "K42"]
-        .iter()
-        .map(|l| {
-            ctx.catalogue
-                .entries
-                .iter()
-                .position(|e| &e.label == l)
-                .unwrap()
-        })
-        .collect();
-    let problem = counterpoise_optimise::problem::VariantProblem::new(
-        &ctx.model,
-        &ctx.catalogue,
-        &ctx.bounds,
-        &set,
-        counterpoise_balance::linear::solve(&ctx.basis, &set),
-        |b| ctx.torques.slot_of(b),
-    )
-    .unwrap();
+    let problem = variant_problem(&ctx, &["m4", "K42"]);
     assert_eq!(problem.solution.nullspace.ncols(), 6);
     assert_eq!(problem.dim(), 2);
     let v = &results[0];
@@ -230,25 +238,7 @@ fn the_lifted_radius_check_is_relative_to_the_counterweights_own_mass() {
     let json = common::case_json("palletizer.json");
     let model = common::model(&json);
     let ctx = counterpoise_optimise::Context::new(&model, None).unwrap();
-    let set: Vec<usize> = ["m4", "m7", "K62"]
-        .iter()
-        .map(|l| {
-            ctx.catalogue
-                .entries
-                .iter()
-                .position(|e| &e.label == l)
-                .unwrap()
-        })
-        .collect();
-    let problem = counterpoise_optimise::problem::VariantProblem::new(
-        &ctx.model,
-        &ctx.catalogue,
-        &ctx.bounds,
-        &set,
-        counterpoise_balance::linear::solve(&ctx.basis, &set),
-        |b| ctx.torques.slot_of(b),
-    )
-    .unwrap();
+    let problem = variant_problem(&ctx, &["m4", "m7", "K62"]);
     let m7 = &problem.counterweights[1];
     assert_eq!(m7.label, "m7");
     let rhi = m7.bounds.radius[1];
