@@ -200,6 +200,29 @@ mod tests {
         }
     }
 
+    /// The proportionality test's tolerance, by hand: 1e-9 of the row's size at an anchor of
+    /// at least a metre, `1e-9·(‖α‖ + max(|c|, 1 m)·‖K‖)`.
+    #[test]
+    fn proportional_rows_are_told_apart_from_nearly_proportional_ones() {
+        let family = |k: [f64; 3], a: [f64; 3]| {
+            let p = DVector::from_vec(vec![k[0], a[0]]);
+            let n = DMatrix::from_row_slice(2, 2, &[k[1], k[2], a[1], a[2]]);
+            proportional(&p, &n, 1, 0)
+        };
+        // α = K/4 exactly: c = 1/4.
+        let c = family([0.01, 0.02, 0.0], [0.0025, 0.005, 0.0]).unwrap();
+        assert!((c - 0.25).abs() < 1e-15);
+        // Off by 1e-10 on a row of size 0.01: the tolerance is 1e-9·(0.0025 + 1·0.01) =
+        // 1.25e-11, so this row is not proportional.
+        assert_eq!(family([0.01, 0.0, 0.0], [0.0025, 1e-10, 0.0]), None);
+        // A coordinate fixed at zero up to 1e-10 on a row of size 1000: the tolerance is
+        // 1e-9·(1e-10 + 1·1000) ≈ 1e-6, so it is proportional with c ≈ 0.
+        let c = family([1000.0, 0.0, 0.0], [0.0, 1e-10, 0.0]).unwrap();
+        assert!(c.abs() < 1e-15);
+        // No K row, no proportionality.
+        assert_eq!(family([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]), None);
+    }
+
     #[test]
     fn nothing_is_restricted_when_no_anchor_is_fixed() {
         let n = DMatrix::<f64>::identity(9, 9);
