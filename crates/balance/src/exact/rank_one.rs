@@ -328,10 +328,11 @@ mod tests {
 
     #[test]
     fn a_stiffness_with_a_constant_part_demands_the_hand_computed_value() {
-        // W = 4, β = 3 and K − α = 1 (K = 1 + z, α = z): K·W − α·β = 4K − 3(K − 1) = K + 3,
-        // zero only at K = −3: no positive spring.
+        // W = 4, 2β = 6 and K − α = 1 (K = 1 + z, α = z): K·W − α·β = 4K − 3(K − 1) = K + 3,
+        // zero only at K = −3: no positive spring. Only the row where W appears (weight 1) is
+        // read, so the form is K + 3, not a multiple of it.
         assert_eq!(
-            lone_spring(&[(&[(3, 1)], 4), (&[(2, 1)], 3), (&[(0, 1), (1, -1)], 1)]),
+            lone_spring(&[(&[(3, 1)], 4), (&[(2, 2)], 6), (&[(0, 1), (1, -1)], 1)]),
             Some(
                 "K1: no spring has the anchors balance requires (K·W − α·βᵀ = 3 + 1·K on every \
                  solution, zero only at K = -3 N/m)"
