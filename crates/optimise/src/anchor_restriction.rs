@@ -223,6 +223,50 @@ mod tests {
         assert_eq!(family([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]), None);
     }
 
+    /// The same family shifted by a physical particular point (K = 1000, a = (1/4, 0.2),
+    /// b = (0.4, −0.1)): the restricted particular point must itself meet the implied rows, and
+    /// a family whose fixed W contradicts them is left alone (no spring is realizable there).
+    #[test]
+    fn a_shifted_family_keeps_its_rows_and_a_contradictory_one_is_left_alone() {
+        let n_vars = 9;
+        let mut cols: Vec<DVector<f64>> = Vec::new();
+        let mut k_dir = DVector::zeros(n_vars);
+        k_dir[0] = 1.0;
+        k_dir[1] = 0.25;
+        cols.push(k_dir);
+        for j in 2..n_vars {
+            let mut e = DVector::zeros(n_vars);
+            e[j] = 1.0;
+            cols.push(e);
+        }
+        let n = DMatrix::from_columns(&cols);
+        // A lifted point off the physical set (W = 0) but on the family: the restriction moves
+        // its W to β/4.
+        let p = DVector::from_vec(vec![
+            1000.0, 250.0, 200.0, 400.0, -100.0, 0.0, 0.0, 0.0, 0.0,
+        ]);
+        let s = planar_spring(0);
+        let (p2, n2) = restrict(std::slice::from_ref(&s), &p, &n).expect("restricted");
+        assert!((p2[5] - 0.25 * p2[3]).abs() < 1e-9, "{p2}");
+        assert!((p2[6] - 0.25 * p2[4]).abs() < 1e-9, "{p2}");
+        assert!(n2.ncols() == 6);
+        // W_xx fixed at 5 while β_x is fixed at 0: `W_xx = β_x/4` cannot hold.
+        let mut cols: Vec<DVector<f64>> = Vec::new();
+        let mut k_dir = DVector::zeros(n_vars);
+        k_dir[0] = 1.0;
+        k_dir[1] = 0.25;
+        cols.push(k_dir);
+        for j in [2, 4, 6, 7, 8] {
+            let mut e = DVector::zeros(n_vars);
+            e[j] = 1.0;
+            cols.push(e);
+        }
+        let n = DMatrix::from_columns(&cols);
+        let p = DVector::from_vec(vec![0.0, 0.0, 0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 0.0]);
+        assert!(!implied_rows(std::slice::from_ref(&s), &p, &n).is_empty());
+        assert!(restrict(std::slice::from_ref(&s), &p, &n).is_none());
+    }
+
     #[test]
     fn nothing_is_restricted_when_no_anchor_is_fixed() {
         let n = DMatrix::<f64>::identity(9, 9);
