@@ -460,6 +460,79 @@ mod tests {
         );
     }
 
+    /// The mass margin by hand: 1 % of a 1000 kg moving mass is 10 kg, so a variant 9 kg
+    /// heavier than the lightest stays in and wins on ΔR, one 11 kg heavier is out; without a
+    /// moving mass (or a zero one) the margin is 1 g and only the lightest stays.
+    #[test]
+    fn the_mass_margin_is_one_percent_of_the_moving_mass() {
+        let group = |extra: f64| {
+            vec![
+                v(
+                    1,
+                    1,
+                    &["m1"],
+                    Class::Counterweights,
+                    (-60.0, -50.0, 2.0),
+                    (5.0, None),
+                ),
+                v(
+                    2,
+                    2,
+                    &["m2"],
+                    Class::Counterweights,
+                    (-60.0, -50.0, 0.0),
+                    (5.0 + extra, None),
+                ),
+            ]
+        };
+        let chosen = |vs: &[VariantRecord], moving: Option<f64>| {
+            let ranked: Vec<&VariantRecord> = vs.iter().collect();
+            decide(&ranked, 0.5, moving).overall.unwrap().chosen
+        };
+        assert_eq!(chosen(&group(9.0), Some(1000.0)), 2);
+        assert_eq!(chosen(&group(11.0), Some(1000.0)), 1);
+        assert_eq!(chosen(&group(9.0), None), 1);
+        assert_eq!(chosen(&group(9.0), Some(0.0)), 1);
+        assert_eq!(chosen(&group(0.0005), None), 2);
+        // A zero moving mass counts as unknown: the 1 g margin, and no share in the reason.
+        assert_eq!(chosen(&group(0.0005), Some(0.0)), 2);
+        let vs = group(11.0);
+        let ranked: Vec<&VariantRecord> = vs.iter().collect();
+        let reason = decide(&ranked, 0.5, Some(0.0)).overall.unwrap().reason;
+        assert!(!reason.contains("moving mass"), "{reason}");
+    }
+
+    /// Spring forces within 5 % tie (1040 N against 1000 N: 4 %), so the rank decides; 1060 N
+    /// (6 %) loses to the weaker spring.
+    #[test]
+    fn spring_forces_within_five_percent_tie() {
+        let pair = |first: f64| {
+            vec![
+                v(
+                    1,
+                    1,
+                    &["K21"],
+                    Class::Springs,
+                    (-60.0, -50.0, 0.0),
+                    (0.0, Some(first)),
+                ),
+                v(
+                    2,
+                    2,
+                    &["K31"],
+                    Class::Springs,
+                    (-60.0, -50.0, 0.0),
+                    (0.0, Some(1000.0)),
+                ),
+            ]
+        };
+        for (first, expected) in [(1040.0, 1), (1060.0, 2)] {
+            let vs = pair(first);
+            let ranked: Vec<&VariantRecord> = vs.iter().collect();
+            assert_eq!(decide(&ranked, 0.5, None).overall.unwrap().chosen, expected);
+        }
+    }
+
     #[test]
     fn nothing_ranked_nothing_recommended() {
         let d = decide(&[], 0.5, None);
