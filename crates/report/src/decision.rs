@@ -529,8 +529,44 @@ mod tests {
         for (first, expected) in [(1040.0, 1), (1060.0, 2)] {
             let vs = pair(first);
             let ranked: Vec<&VariantRecord> = vs.iter().collect();
-            assert_eq!(decide(&ranked, 0.5, None).overall.unwrap().chosen, expected);
+            let o = decide(&ranked, 0.5, None).overall.unwrap();
+            assert_eq!(o.chosen, expected);
+            // Two left after the force step: the rank decides, and the reason says so.
+            assert_eq!(
+                o.reason.contains("the best rank (1)"),
+                expected == 1,
+                "{}",
+                o.reason
+            );
         }
+    }
+
+    /// Equal mass, ΔR and spring force: the variant with fewer elements wins over the better
+    /// rank.
+    #[test]
+    fn fewer_elements_win_before_the_rank() {
+        let vs = [
+            v(
+                1,
+                1,
+                &["K21", "K31", "K41"],
+                Class::Springs,
+                (-60.0, -50.0, 0.0),
+                (0.0, Some(1000.0)),
+            ),
+            v(
+                2,
+                2,
+                &["K21", "K31"],
+                Class::Springs,
+                (-60.0, -50.0, 0.0),
+                (0.0, Some(1000.0)),
+            ),
+        ];
+        let ranked: Vec<&VariantRecord> = vs.iter().collect();
+        let o = decide(&ranked, 0.5, None).overall.unwrap();
+        assert_eq!(o.chosen, 2);
+        assert!(o.reason.contains("the fewest elements (2)"), "{}", o.reason);
     }
 
     #[test]
