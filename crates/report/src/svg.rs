@@ -377,6 +377,36 @@ fn left_margin(y_lo: f64, y_hi: f64) -> f64 {
     (30.0 + y_label_room(y_lo, y_hi) + 10.0).max(58.0)
 }
 
+/// The x ticks below the frame, the frame itself and the x-axis title (`height`: the chart's).
+fn x_axis(out: &mut String, f: &Frame, height: f64, x_label: &str) {
+    let (ticks, step) = nice_ticks(f.x_lo, f.x_hi, 8);
+    for t in ticks
+        .iter()
+        .filter(|t| **t >= f.x_lo - 1e-9 * step && **t <= f.x_hi + 1e-9 * step)
+    {
+        let x = f.x(*t);
+        let _ = write!(
+            out,
+            r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#888888" stroke-width="1"/><text x="{x:.1}" y="{:.1}" font-size="{SMALL}" text-anchor="middle">{}</text>"##,
+            f.top + f.h,
+            f.top + f.h + 5.0,
+            f.top + f.h + 18.0,
+            tick_label(*t, step)
+        );
+    }
+    let _ = write!(
+        out,
+        r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="none" stroke="#888888" stroke-width="1"/><text x="{:.1}" y="{:.1}" font-size="{FONT}" text-anchor="middle">{}</text>"##,
+        f.left,
+        f.top,
+        f.w,
+        f.h,
+        f.left + f.w / 2.0,
+        height - 10.0,
+        escape_html(x_label)
+    );
+}
+
 fn y_axis(out: &mut String, f: &Frame, y_label: &str) {
     let (ticks, step) = nice_ticks(f.y_lo, f.y_hi, 6);
     for t in ticks
@@ -493,30 +523,7 @@ pub fn line_chart(chart: &LineChart) -> String {
         y_hi,
     };
     y_axis(&mut out, &f, &chart.y_label);
-    let (ticks, step) = nice_ticks(x_lo, x_hi, 8);
-    for t in ticks
-        .iter()
-        .filter(|t| **t >= x_lo - 1e-9 * step && **t <= x_hi + 1e-9 * step)
-    {
-        let x = f.x(*t);
-        let _ = write!(
-            out,
-            r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#888888" stroke-width="1"/><text x="{x:.1}" y="{:.1}" font-size="{SMALL}" text-anchor="middle">{}</text>"##,
-            f.top + f.h,
-            f.top + f.h + 5.0,
-            f.top + f.h + 18.0,
-            tick_label(*t, step)
-        );
-    }
-    let _ = write!(
-        out,
-        r##"<rect x="{left:.1}" y="{top:.1}" width="{:.1}" height="{:.1}" fill="none" stroke="#888888" stroke-width="1"/><text x="{:.1}" y="{:.1}" font-size="{FONT}" text-anchor="middle">{}</text>"##,
-        f.w,
-        f.h,
-        left + f.w / 2.0,
-        height - 10.0,
-        escape_html(&chart.x_label)
-    );
+    x_axis(&mut out, &f, height, &chart.x_label);
     // Drawn last-to-first, so the first series (the reference) lies on top; coinciding curves
     // stay distinguishable by their dash patterns and staggered markers.
     let n = series.len().max(1);
@@ -835,30 +842,7 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
         );
     }
     y_axis(&mut out, &f, &chart.y_label);
-    let (ticks, step) = nice_ticks(x_lo, x_hi, 8);
-    for t in ticks
-        .iter()
-        .filter(|t| **t >= x_lo - 1e-9 * step && **t <= x_hi + 1e-9 * step)
-    {
-        let x = f.x(*t);
-        let _ = write!(
-            out,
-            r##"<line x1="{x:.1}" y1="{:.1}" x2="{x:.1}" y2="{:.1}" stroke="#888888" stroke-width="1"/><text x="{x:.1}" y="{:.1}" font-size="{SMALL}" text-anchor="middle">{}</text>"##,
-            f.top + f.h,
-            f.top + f.h + 5.0,
-            f.top + f.h + 18.0,
-            tick_label(*t, step)
-        );
-    }
-    let _ = write!(
-        out,
-        r##"<rect x="{left:.1}" y="{top:.1}" width="{:.1}" height="{:.1}" fill="none" stroke="#888888" stroke-width="1"/><text x="{:.1}" y="{:.1}" font-size="{FONT}" text-anchor="middle">{}</text>"##,
-        f.w,
-        f.h,
-        left + f.w / 2.0,
-        height - 10.0,
-        escape_html(&chart.x_label)
-    );
+    x_axis(&mut out, &f, height, &chart.x_label);
     if chart.front.len() > 1 {
         let mut pts = String::new();
         for (k, (x, y)) in chart.front.iter().enumerate() {
