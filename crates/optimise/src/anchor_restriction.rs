@@ -146,6 +146,22 @@ mod tests {
         }
     }
 
+    /// Free directions over one planar spring's nine lifted variables
+    /// `(K, αx, αy, βx, βy, Wxx, Wxy, Wyx, Wyy)`: K moves αx by 1/4 (balance fixes a_x = 1/4),
+    /// and each listed variable moves alone.
+    fn quarter_anchor_family(free: impl IntoIterator<Item = usize>) -> DMatrix<f64> {
+        let mut k_dir = DVector::zeros(9);
+        k_dir[0] = 1.0;
+        k_dir[1] = 0.25;
+        let mut cols = vec![k_dir];
+        for j in free {
+            let mut e = DVector::zeros(9);
+            e[j] = 1.0;
+            cols.push(e);
+        }
+        DMatrix::from_columns(&cols)
+    }
+
     /// A hand-made family over one planar spring, x = (K, αx, αy, βx, βy, Wxx, Wxy, Wyx, Wyy):
     /// balance fixes αx = K/4 (a_x = 1/4) and leaves everything else free. Every realizable
     /// point has Wxx = βx/4 and Wxy = βy/4; the restricted family must contain every physical
@@ -153,18 +169,7 @@ mod tests {
     #[test]
     fn a_fixed_anchor_coordinate_makes_its_w_row_linear() {
         let n_vars = 9;
-        // Free directions: K moves αx by 1/4; every other variable but αx is free.
-        let mut cols: Vec<DVector<f64>> = Vec::new();
-        let mut k_dir = DVector::zeros(n_vars);
-        k_dir[0] = 1.0;
-        k_dir[1] = 0.25;
-        cols.push(k_dir);
-        for j in 2..n_vars {
-            let mut e = DVector::zeros(n_vars);
-            e[j] = 1.0;
-            cols.push(e);
-        }
-        let n = DMatrix::from_columns(&cols);
+        let n = quarter_anchor_family(2..n_vars);
         let p = DVector::zeros(n_vars);
         let s = planar_spring(0);
         let rows = implied_rows(std::slice::from_ref(&s), &p, &n);
@@ -229,17 +234,7 @@ mod tests {
     #[test]
     fn a_shifted_family_keeps_its_rows_and_a_contradictory_one_is_left_alone() {
         let n_vars = 9;
-        let mut cols: Vec<DVector<f64>> = Vec::new();
-        let mut k_dir = DVector::zeros(n_vars);
-        k_dir[0] = 1.0;
-        k_dir[1] = 0.25;
-        cols.push(k_dir);
-        for j in 2..n_vars {
-            let mut e = DVector::zeros(n_vars);
-            e[j] = 1.0;
-            cols.push(e);
-        }
-        let n = DMatrix::from_columns(&cols);
+        let n = quarter_anchor_family(2..n_vars);
         // A lifted point off the physical set (W = 0) but on the family: the restriction moves
         // its W to β/4.
         let p = DVector::from_vec(vec![
@@ -251,17 +246,7 @@ mod tests {
         assert!((p2[6] - 0.25 * p2[4]).abs() < 1e-9, "{p2}");
         assert!(n2.ncols() == 6);
         // W_xx fixed at 5 while β_x is fixed at 0: `W_xx = β_x/4` cannot hold.
-        let mut cols: Vec<DVector<f64>> = Vec::new();
-        let mut k_dir = DVector::zeros(n_vars);
-        k_dir[0] = 1.0;
-        k_dir[1] = 0.25;
-        cols.push(k_dir);
-        for j in [2, 4, 6, 7, 8] {
-            let mut e = DVector::zeros(n_vars);
-            e[j] = 1.0;
-            cols.push(e);
-        }
-        let n = DMatrix::from_columns(&cols);
+        let n = quarter_anchor_family([2, 4, 6, 7, 8]);
         let p = DVector::from_vec(vec![0.0, 0.0, 0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 0.0]);
         assert!(!implied_rows(std::slice::from_ref(&s), &p, &n).is_empty());
         assert!(restrict(std::slice::from_ref(&s), &p, &n).is_none());
