@@ -5,9 +5,11 @@
 //! [`symbolic`] (trigonometric-polynomial algebra), [`model`] (case format, validation,
 //! kinematics), [`balance`] (exact balancing search), [`dynamics`] (inverse dynamics and
 //! indicators over tasks), and [`preflight`]: the checks `check` runs beyond validation and the
-//! guards of the costly stages.
+//! guards of the costly stages; and [`shard`]: splitting a study's balanced variants into
+//! shards of equal expected cost.
 
 pub mod preflight;
+pub mod shard;
 
 pub use counterpoise_balance as balance;
 pub use counterpoise_dynamics as dynamics;

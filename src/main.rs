@@ -104,6 +104,25 @@ enum Command {
         /// No progress on stderr (the summary still goes to stdout).
         #[arg(long, short)]
         quiet: bool,
+        /// Optimise only shard I of N (1-based, as SLURM_ARRAY_TASK_ID) and write
+        /// DIR/shard-I-of-N.json for `merge` instead of the reports.
+        #[arg(long, value_name = "I/N", value_parser = parse_shard)]
+        shard: Option<counterpoise::shard::ShardSpec>,
+        #[command(flatten)]
+        jobs: Jobs,
+    },
+    /// Merge the shards of a study (`run --shard I/N`) into results.json and the reports, as a
+    /// single run writes them.
+    Merge {
+        /// Shard files, or directories holding them (shard-I-of-N.json).
+        #[arg(required = true, value_name = "DIR")]
+        inputs: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress on stderr (the summary still goes to stdout).
+        #[arg(long, short)]
+        quiet: bool,
         #[command(flatten)]
         jobs: Jobs,
     },
@@ -178,7 +197,8 @@ fn jobs_of(command: &Command) -> Option<usize> {
         Command::Check { jobs, .. }
         | Command::Variants { jobs, .. }
         | Command::Evaluate { jobs, .. }
-        | Command::Run { jobs, .. } => jobs.jobs,
+        | Command::Run { jobs, .. }
+        | Command::Merge { jobs, .. } => jobs.jobs,
         Command::ImportUrdf { .. } | Command::Report { .. } => None,
     }
 }
@@ -233,6 +253,7 @@ fn run(cli: Cli) -> ExitCode {
             resolution,
             tolerance,
             quiet,
+            shard,
             ..
         } => commands::run::run(
             &case,
@@ -243,7 +264,23 @@ fn run(cli: Cli) -> ExitCode {
                 minimax,
                 resolution,
                 tolerance,
-                progress: commands::progress::Progress::detect(quiet, 4),
+                // a shard stops after the optimisation: three phases
+                progress: commands::progress::Progress::detect(
+                    quiet,
+                    if shard.is_some() { 3 } else { 4 },
+                ),
+                shard,
+            },
+        ),
+        Command::Merge {
+            inputs, out, quiet, ..
+        } => commands::merge::run(
+            &inputs,
+            commands::merge::Options {
+                out,
+                jobs: rayon::current_num_threads(),
+                // Phase 1 and the search again, then Phase 3
+                progress: commands::progress::Progress::detect(quiet, 3),
             },
         ),
         Command::Report { dir, tolerance } => commands::report(&dir, tolerance),
@@ -279,6 +316,12 @@ fn parse_task(text: &str) -> Result<(usize, usize), String> {
             .map_err(|_| format!("`{s}` is not a grid index"))
     };
     Ok((parse(i)?, parse(j)?))
+}
+
+/// `I/N`: shard I of N, 1 ≤ I ≤ N.
+fn parse_shard(text: &str) -> Result<counterpoise::shard::ShardSpec, String> {
+    text.parse()
+        .map_err(|e: counterpoise::shard::ShardSpecError| e.to_string())
 }
 
 /// Percentage points: a finite number ≥ 0.

@@ -3,8 +3,10 @@
 pub mod check;
 pub mod evaluate;
 pub mod import_urdf;
+pub mod merge;
 pub mod progress;
 pub mod run;
+pub mod shard_file;
 pub mod states;
 pub mod variants;
 

@@ -1,29 +1,35 @@
 //! `counterpoise run CASE`: the whole case study — Phase 1 (unbalanced robot), Phase 2 (balance
 //! search, optimisation with re-evaluation over all tasks), Phase 3 (ranking, reports).
+//!
+//! With `--shard I/N` only the balanced variants of shard I are optimised and the result is a
+//! partial file (see [`super::shard_file`]); `merge` then runs Phase 3 on every shard's records
+//! through [`finish`], the same function a single run ends with.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use anyhow::{Context as _, Result, bail};
+use counterpoise::shard::{self, ShardSpec};
 use counterpoise_balance::{
-    Catalogue, SearchOptions, Status, VariantResult, catalogue_options, mechanism_energy,
-    realization_hints, search,
+    Catalogue, SearchOptions, SearchReport, Status, VariantResult, catalogue_options,
+    mechanism_energy, realization_hints, search,
 };
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{
     Counterweight, EvaluateOptions, Indicators, Spring, Variant, evaluate_grid, task_series_with,
 };
 use counterpoise_model::Model;
-use counterpoise_optimise::{
-    Context, Objective, OptimiseOptions, OptimisedVariant, optimise_all_reporting,
-};
+use counterpoise_optimise::{Context, Objective, OptimiseOptions, optimise_all_reporting};
 use counterpoise_report as report;
 use report::{
     ActuatorSummary, ElementInfo, ElementKind, Evaluation, FreeDirection, JointPeak, OptimiserInfo,
     PhaseTiming, PhysicalParameters, RankingOptions, RunMetadata, RunResults, VariantRecord,
     VariantStatus,
 };
+
+use super::shard_file::{self, OptimisedRecord, Outcome, ShardFile, StudyKey};
 
 /// Options of the command.
 pub struct Options {
@@ -36,14 +42,24 @@ pub struct Options {
     pub tolerance: f64,
     /// How progress is shown on stderr.
     pub progress: super::progress::Progress,
+    /// Optimise only this shard's variants and write a partial result.
+    pub shard: Option<ShardSpec>,
 }
 
-struct Timer {
-    timings: Vec<PhaseTiming>,
+/// Times the phases and shows their progress.
+pub struct Timer {
+    pub timings: Vec<PhaseTiming>,
     progress: super::progress::Progress,
 }
 
 impl Timer {
+    pub fn new(progress: super::progress::Progress) -> Timer {
+        Timer {
+            timings: Vec::new(),
+            progress,
+        }
+    }
+
     fn time<T>(&mut self, name: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
         self.time_reporting(name, |_| work())
     }
@@ -67,60 +83,119 @@ impl Timer {
     }
 }
 
+/// What a study computes before the optimisation: Phase 1 and the balance search. Every shard
+/// and the merge compute it again (a few seconds even at Dmax 3) rather than share a file.
+pub struct Front {
+    pub unbalanced: Indicators,
+    /// Tasks, excluded tasks, whether the reactions are minimum-norm.
+    pub grid_info: (usize, usize, bool),
+    pub found: SearchReport,
+}
+
+/// Everything Phase 3 needs besides the computed results.
+pub struct Study<'a> {
+    pub model: &'a Model,
+    pub case_path: String,
+    pub dmax: usize,
+    pub jobs: usize,
+    pub ranking: RankingOptions,
+    /// N when the study was merged from shards.
+    pub shards: Option<usize>,
+}
+
 pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     let Some(model) = super::load(path)? else {
         return Ok(ExitCode::FAILURE);
     };
-    let Some(balancing) = &model.balancing else {
-        bail!("{}: the case has no `balancing` section", path.display());
-    };
-    if model.tasks.is_none() {
-        bail!("{}: the case has no `tasks` section", path.display());
-    }
-    let dmax = options.dmax.unwrap_or(balancing.dmax);
-    if dmax == 0 {
-        bail!("--dmax must be at least 1");
-    }
-    if !super::before_run(path, &model, options.dmax.is_some(), dmax) {
+    let Some(dmax) = checked_dmax(path, &model, options.dmax, options.progress.mode)? else {
         return Ok(ExitCode::FAILURE);
-    }
-    if let (Some(note), false) = (
-        super::derived_bounds_note(&model),
-        options.progress.mode == super::progress::Mode::Quiet,
-    ) {
-        eprintln!("note: {note}");
-    }
+    };
     let out_dir = options
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&model.name));
     std::fs::create_dir_all(&out_dir)
         .with_context(|| format!("cannot create the output directory {}", out_dir.display()))?;
-    let mut timer = Timer {
-        timings: Vec::new(),
-        progress: options.progress,
+    let mut timer = Timer::new(options.progress);
+    let front = front(&model, dmax, &mut timer)?;
+    let balanced = balanced_ids(&front.found.variants);
+    if let Some(spec) = options.shard {
+        return run_shard(path, &model, dmax, &front, spec, &options, timer, &out_dir);
+    }
+    let phase = format!(
+        "Phase 2: optimisation of the {} balanced variants",
+        balanced.len()
+    );
+    let optimised = optimise(
+        &model,
+        &front,
+        &balanced,
+        options.minimax,
+        &mut timer,
+        &phase,
+    )?;
+    let study = Study {
+        model: &model,
+        case_path: path.display().to_string(),
+        dmax,
+        jobs: options.jobs,
+        ranking: RankingOptions {
+            resolution: options.resolution,
+            tolerance: options.tolerance,
+        },
+        shards: None,
     };
+    finish(&study, &front, &optimised, timer, &out_dir)
+}
 
-    // Phase 1: the unbalanced robot over every task, with joint reactions.
-    let (unbalanced, ub_grid_info) =
-        timer.time("Phase 1: unbalanced robot over all tasks", || {
-            let grid = evaluate_grid(
-                &model,
-                &ParameterSet::unbalanced(&model),
-                &EvaluateOptions::default(),
-            )?;
-            let info = (
-                grid.tasks.len(),
-                grid.excluded.count,
-                grid.reactions_minimum_norm,
-            );
-            Ok((grid.indicators[0].clone(), info))
-        })?;
+/// The effective Dmax after the guards of `run` (printed when they fail: `None`).
+pub fn checked_dmax(
+    path: &Path,
+    model: &Model,
+    dmax: Option<usize>,
+    mode: super::progress::Mode,
+) -> Result<Option<usize>> {
+    let Some(balancing) = &model.balancing else {
+        bail!("{}: the case has no `balancing` section", path.display());
+    };
+    if model.tasks.is_none() {
+        bail!("{}: the case has no `tasks` section", path.display());
+    }
+    let effective = dmax.unwrap_or(balancing.dmax);
+    if effective == 0 {
+        bail!("--dmax must be at least 1");
+    }
+    if !super::before_run(path, model, dmax.is_some(), effective) {
+        return Ok(None);
+    }
+    if let (Some(note), false) = (
+        super::derived_bounds_note(model),
+        mode == super::progress::Mode::Quiet,
+    ) {
+        eprintln!("note: {note}");
+    }
+    Ok(Some(effective))
+}
 
-    // Phase 2: exact balance search.
+/// Phase 1 (the unbalanced robot over every task, with joint reactions) and the exact balance
+/// search.
+pub fn front(model: &Model, dmax: usize, timer: &mut Timer) -> Result<Front> {
+    let (unbalanced, grid_info) = timer.time("Phase 1: unbalanced robot over all tasks", || {
+        let grid = evaluate_grid(
+            model,
+            &ParameterSet::unbalanced(model),
+            &EvaluateOptions::default(),
+        )?;
+        let info = (
+            grid.tasks.len(),
+            grid.excluded.count,
+            grid.reactions_minimum_norm,
+        );
+        Ok((grid.indicators[0].clone(), info))
+    })?;
     let found = timer.time("Phase 2: balance search", || {
-        let energy = mechanism_energy(&model);
-        let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+        let energy = mechanism_energy(model);
+        let catalogue = Catalogue::build(&energy, &catalogue_options(model));
         if catalogue.is_empty() {
             bail!("`balancing` allows no counterweight and no spring");
         }
@@ -129,26 +204,51 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
             catalogue,
             SearchOptions {
                 dmax,
-                hints: realization_hints(&model),
+                hints: realization_hints(model),
             },
         ))
     })?;
+    Ok(Front {
+        unbalanced,
+        grid_info,
+        found,
+    })
+}
 
-    // Phase 2: optimisation of every balanced variant, re-evaluated over all tasks.
-    let balanced_count = found
-        .variants
+/// Enumeration indices of the balanced variants.
+fn balanced_ids(variants: &[VariantResult]) -> Vec<usize> {
+    (0..variants.len())
+        .filter(|&k| variants[k].status == Status::Balanced)
+        .collect()
+}
+
+/// The optimiser's objective for `--minimax`.
+pub fn objective(minimax: bool) -> Objective {
+    if minimax {
+        Objective::Minimax
+    } else {
+        Objective::RmsStar
+    }
+}
+
+/// Optimises the balanced variants `ids` (enumeration indices, increasing), re-evaluated over
+/// all tasks, as phase `phase`.
+fn optimise(
+    model: &Model,
+    front: &Front,
+    ids: &[usize],
+    minimax: bool,
+    timer: &mut Timer,
+    phase: &str,
+) -> Result<Vec<OptimisedRecord>> {
+    let variants: Vec<VariantResult> = ids
         .iter()
-        .filter(|v| v.status == Status::Balanced)
-        .count();
-    let phase_name = format!("Phase 2: optimisation of the {balanced_count} balanced variants");
-    let optimised = timer.time_reporting(&phase_name, |phase| {
-        let context = Context::new(&model, Some(unbalanced.clone()))?;
+        .map(|&k| front.found.variants[k].clone())
+        .collect();
+    timer.time_reporting(phase, |phase| {
+        let context = Context::new(model, Some(front.unbalanced.clone()))?;
         let settings = OptimiseOptions {
-            objective: if options.minimax {
-                Objective::Minimax
-            } else {
-                Objective::RmsStar
-            },
+            objective: objective(minimax),
             ..OptimiseOptions::default()
         };
         let report = |p: counterpoise_optimise::StageProgress| {
@@ -161,26 +261,114 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
             };
             phase.report(&stage, p.done, p.total);
         };
-        Ok(optimise_all_reporting(&context, &found.variants, &settings, &report).0)
-    })?;
+        let optimised = optimise_all_reporting(&context, &variants, &settings, &report).0;
+        if optimised.len() != ids.len() {
+            bail!(
+                "the optimiser returned {} results for {} balanced variants",
+                optimised.len(),
+                ids.len()
+            );
+        }
+        Ok(ids
+            .iter()
+            .zip(&optimised)
+            .map(|(&id, o)| OptimisedRecord::new(id, o))
+            .collect())
+    })
+}
 
-    // Phase 3: ranking and reports.
+/// `run --shard I/N`: optimises shard I's variants and writes `DIR/shard-I-of-N.json`.
+#[allow(clippy::too_many_arguments)]
+fn run_shard(
+    path: &Path,
+    model: &Model,
+    dmax: usize,
+    front: &Front,
+    spec: ShardSpec,
+    options: &Options,
+    mut timer: Timer,
+    out_dir: &Path,
+) -> Result<ExitCode> {
+    let balanced = balanced_ids(&front.found.variants);
+    let ids = shard::shard_variants(&front.found.variants, spec);
+    let cost = |ids: &[usize]| -> u64 {
+        ids.iter()
+            .map(|&k| shard::expected_cost(shard::CostFeatures::of(&front.found.variants[k])))
+            .sum()
+    };
+    let phase = format!(
+        "Phase 2: optimisation of shard {spec}: {} of the {} balanced variants",
+        ids.len(),
+        balanced.len()
+    );
+    let optimised = optimise(model, front, &ids, options.minimax, &mut timer, &phase)?;
+    let case_text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let file = ShardFile {
+        format: shard_file::FORMAT.into(),
+        format_version: shard_file::FORMAT_VERSION,
+        study: StudyKey {
+            case_sha256: shard_file::case_sha256(model)?,
+            dmax,
+            objective: objective(options.minimax),
+            resolution: options.resolution,
+            tolerance: options.tolerance,
+            shards: spec.count,
+            tool_version: env!("CARGO_PKG_VERSION").into(),
+        },
+        shard: spec.index,
+        case_path: path.display().to_string(),
+        case_text,
+        balanced: balanced.len(),
+        expected_cost: cost(&ids),
+        study_expected_cost: cost(&balanced),
+        variants: ids,
+        unbalanced: front.unbalanced.clone(),
+        timings: timer.timings,
+        optimised,
+    };
+    let written = shard_file::write(out_dir, &file)?;
+    let seconds: f64 = file.timings.iter().map(|t| t.seconds).sum();
+    println!(
+        "{}: shard {spec}: {} of {} balanced variants (expected cost {:.1} % of the study) \
+         optimised in {seconds:.1} s",
+        model.name,
+        file.variants.len(),
+        file.balanced,
+        100.0 * file.expected_cost as f64 / file.study_expected_cost.max(1) as f64,
+    );
+    println!("wrote {}", written.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Phase 3 and the outputs, from the optimiser's records of every balanced variant (in any
+/// order): the end of a single run and all of a merge's work after its checks.
+pub fn finish(
+    study: &Study,
+    front: &Front,
+    optimised: &[OptimisedRecord],
+    mut timer: Timer,
+    out_dir: &Path,
+) -> Result<ExitCode> {
+    let model = study.model;
+    let ub_grid_info = front.grid_info;
     let mut results = RunResults::new(
         RunMetadata {
             tool: "counterpoise".into(),
             tool_version: env!("CARGO_PKG_VERSION").into(),
             case_name: model.name.clone(),
-            case_path: path.display().to_string(),
-            dmax,
-            jobs: options.jobs,
+            case_path: study.case_path.clone(),
+            dmax: study.dmax,
+            jobs: study.jobs,
+            shards: study.shards,
             date: utc_now(),
             timings: Vec::new(),
             notes: Vec::new(),
         },
         serde_json::to_value(&model.case)?,
-        evaluation(&unbalanced, ub_grid_info),
+        evaluation(&front.unbalanced, ub_grid_info),
     );
-    if let Some(note) = super::derived_bounds_note(&model) {
+    if let Some(note) = super::derived_bounds_note(model) {
         results
             .metadata
             .notes
@@ -193,38 +381,38 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
                 .into(),
         );
     }
-    let mut balanced = optimised.iter();
-    for (id, v) in found.variants.iter().enumerate() {
-        let opt = (v.status == Status::Balanced).then(|| {
-            balanced
-                .next()
-                .expect("the optimiser returns one result per balanced variant")
-        });
+    let by_id: BTreeMap<usize, &OptimisedRecord> =
+        optimised.iter().map(|o| (o.variant, o)).collect();
+    for (id, v) in front.found.variants.iter().enumerate() {
+        let opt = if v.status == Status::Balanced {
+            let Some(o) = by_id.get(&id) else {
+                bail!("no optimisation result for the balanced variant {id}");
+            };
+            Some(*o)
+        } else {
+            None
+        };
         results
             .variants
-            .push(record(&model, id, v, opt, ub_grid_info));
+            .push(record(model, id, v, opt, ub_grid_info));
     }
     results.moving_mass = Some(model.bodies.iter().map(|b| b.mass).sum());
     timer.time("Phase 3: ranking, torque curves, path", || {
-        let ranking = RankingOptions {
-            resolution: options.resolution,
-            tolerance: options.tolerance,
-        };
-        results.finalize(&ranking)?;
-        let mechanisms = best_mechanisms(&model, &results, &optimised)?;
-        add_torque_charts(&model, &mut results, &mechanisms)?;
+        results.finalize(&study.ranking)?;
+        let mechanisms = best_mechanisms(model, &results, optimised)?;
+        add_torque_charts(model, &mut results, &mechanisms)?;
         let mut path_configurations = Vec::new();
         if !model.paths.is_empty() {
-            let (simulation, q) = path_simulation(&model, &mechanisms, 0)?;
+            let (simulation, q) = path_simulation(model, &mechanisms, 0)?;
             results.path = Some(simulation);
             path_configurations = q;
         }
-        add_practical_figures(&model, &mut results, path_configurations)?;
-        results.finalize(&ranking)?;
+        add_practical_figures(model, &mut results, path_configurations)?;
+        results.finalize(&study.ranking)?;
         Ok(())
     })?;
     results.metadata.timings = timer.timings;
-    let written = report::write_outputs(&out_dir, &results)?;
+    let written = report::write_outputs(out_dir, &results)?;
     print!("{}", report::text::summary(&results));
     for f in written {
         println!("wrote {}", f.display());
@@ -322,7 +510,7 @@ fn record(
     model: &Model,
     id: usize,
     v: &VariantResult,
-    opt: Option<&OptimisedVariant>,
+    opt: Option<&OptimisedRecord>,
     grid_info: (usize, usize, bool),
 ) -> VariantRecord {
     let elements = v
@@ -372,7 +560,7 @@ fn record(
         objective: opt.objective,
         lower_bound: opt.lower_bound,
         gap: opt.gap,
-        iterations: Some(opt.iterations.len()),
+        iterations: Some(opt.iterations),
         message: opt.reason.clone(),
     });
     let balancing = model.balancing.as_ref();
@@ -412,7 +600,7 @@ fn record(
             })
             .collect(),
     });
-    match (opt.is_feasible(), &opt.indicators) {
+    match (opt.outcome == Outcome::Feasible, &opt.indicators) {
         (true, Some(ind)) => {
             r.status = VariantStatus::Feasible;
             r.evaluation = Some(evaluation(ind, grid_info));
@@ -425,7 +613,7 @@ fn record(
             r.reason = Some("optimised, but not re-evaluated over all tasks".into());
         }
         (false, _) => {
-            r.status = if opt.status == counterpoise_optimise::OptimisedStatus::Undecided {
+            r.status = if opt.outcome == Outcome::Undecided {
                 VariantStatus::Undecided
             } else {
                 VariantStatus::Discarded
@@ -454,7 +642,7 @@ fn significant(x: f64, digits: usize) -> f64 {
 }
 
 /// The dynamics crate's description of a variant's elements.
-fn dynamics_variant(model: &Model, opt: &OptimisedVariant) -> Result<Variant> {
+fn dynamics_variant(model: &Model, opt: &OptimisedRecord) -> Result<Variant> {
     let body = |name: &str| {
         model
             .body_index(name)
@@ -494,13 +682,13 @@ struct Mechanisms {
 fn best_mechanisms(
     model: &Model,
     results: &RunResults,
-    optimised: &[OptimisedVariant],
+    optimised: &[OptimisedRecord],
 ) -> Result<Mechanisms> {
     let mut variants = vec![Variant::default()];
     let mut labels = vec![("UB".to_string(), None)];
     for v in results.best_per_class() {
         let label = v.label();
-        let Some(opt) = optimised.iter().find(|o| o.elements.join(" + ") == label) else {
+        let Some(opt) = optimised.iter().find(|o| o.label() == label) else {
             continue;
         };
         variants.push(dynamics_variant(model, opt)?);

@@ -404,6 +404,10 @@ pub struct RunMetadata {
     pub dmax: usize,
     /// Worker threads (results do not depend on it).
     pub jobs: usize,
+    /// N when the results were merged from N shards (`counterpoise merge`); absent for a
+    /// single run. The results do not depend on it either.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shards: Option<usize>,
     /// Timestamp supplied by the caller (e.g. RFC 3339, UTC); kept verbatim.
     pub date: String,
     pub timings: Vec<PhaseTiming>,

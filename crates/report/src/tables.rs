@@ -98,17 +98,23 @@ pub fn metadata(r: &RunResults) -> Table {
     let mut t = Table::new(&["", ""]);
     let examined = r.variants.len().to_string();
     let total: f64 = m.timings.iter().map(|p| p.seconds).sum();
-    for (k, v) in [
+    let mut rows = vec![
         ("Case", m.case_name.clone()),
         ("Case file", m.case_path.clone()),
         ("Date", m.date.clone()),
         ("Tool", format!("{} {}", m.tool, m.tool_version)),
         ("Dmax", m.dmax.to_string()),
         ("Worker threads", m.jobs.to_string()),
+    ];
+    if let Some(n) = m.shards {
+        rows.push(("Merged from", format!("{n} shards")));
+    }
+    rows.extend([
         ("Variants examined", examined),
         ("Wall time", format!("{} s", seconds(total))),
         ("Schema version", r.schema_version.to_string()),
-    ] {
+    ]);
+    for (k, v) in rows {
         t.push(vec![Cell::text(k), Cell::text(v)], false);
     }
     t

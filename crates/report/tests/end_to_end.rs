@@ -138,6 +138,7 @@ fn sample() -> RunResults {
         case_path: "cases/palletizer.json".into(),
         dmax: 2,
         jobs: 2,
+        shards: None,
         date: "2026-11-22T00:00:00Z".into(),
         timings: vec![
             PhaseTiming {
