@@ -12,7 +12,7 @@ use common::{assert_success, counterpoise, reduced_palletizer, results, stderr, 
 /// (the fields `merge` is allowed to change).
 fn comparable(mut doc: serde_json::Value) -> serde_json::Value {
     let metadata = doc["metadata"].as_object_mut().expect("metadata");
-    for key in ["timings", "date", "jobs", "shards"] {
+    for key in ["timings", "shard_timings", "date", "jobs", "shards"] {
         metadata.remove(key);
     }
     doc
@@ -62,6 +62,11 @@ fn assert_merge_equals_single(case: &str, n: usize, single: &serde_json::Value, 
     assert_success(&o);
     let merged = results(&out);
     assert_eq!(merged["metadata"]["shards"], serde_json::json!(n));
+    // each shard's three phases (Phase 1, search, its optimisation)
+    assert_eq!(
+        merged["metadata"]["shard_timings"].as_array().map(Vec::len),
+        Some(3 * n)
+    );
     assert!(
         comparable(merged.clone()) == comparable(single.clone()),
         "{n} shards: the merged results.json differs from the single run's"
@@ -87,6 +92,7 @@ fn merged_two_link_study_equals_the_single_run_for_one_two_and_three_shards() {
         .count();
     assert!(feasible >= 2, "the comparison needs ranked variants");
     assert!(single["metadata"].get("shards").is_none());
+    assert!(single["metadata"].get("shard_timings").is_none());
     for n in 1..=3 {
         assert_merge_equals_single(case, n, &single, &[]);
     }
@@ -127,6 +133,11 @@ fn malformed_shard_specs_are_usage_errors_naming_the_spec() {
             "{spec}: {err}"
         );
         assert!(!err.contains("panicked"), "{err}");
+    }
+    // merge needs at least one input and an output directory
+    for args in [&["merge", "--out", "x"][..], &["merge", "shards"]] {
+        let o = counterpoise(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
     }
 }
 

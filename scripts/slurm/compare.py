@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Compares two results.json files as `counterpoise merge` promises: equal JSON values once the
 run metadata that describes how the run was made, not what it found, is removed
-(metadata.timings, metadata.date, metadata.jobs, metadata.shards).
+(metadata.timings, shard_timings, date, jobs and shards).
 
 Usage: compare.py A/results.json B/results.json — exit 0 when equal, 1 (with the first
 differences) otherwise. Numbers are compared as the JSON text holds them (shortest round-trip
@@ -9,7 +9,7 @@ decimals), so equal means bit-identical doubles."""
 import json
 import sys
 
-IGNORED = ("timings", "date", "jobs", "shards")
+IGNORED = ("timings", "shard_timings", "date", "jobs", "shards")
 
 
 def load(path):

@@ -136,8 +136,8 @@ pub fn run(inputs: &[PathBuf], options: Options) -> Result<ExitCode> {
             tolerance: first.study.tolerance,
         },
         shards: Some(count),
+        shard_timings,
     };
-    timer.timings.extend(shard_timings);
     finish(&study, &front, &optimised, timer, &options.out)
 }
 

@@ -101,6 +101,8 @@ pub struct Study<'a> {
     pub ranking: RankingOptions,
     /// N when the study was merged from shards.
     pub shards: Option<usize>,
+    /// The shards' own phases, for merged results.
+    pub shard_timings: Vec<PhaseTiming>,
 }
 
 pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
@@ -144,6 +146,7 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
             tolerance: options.tolerance,
         },
         shards: None,
+        shard_timings: Vec::new(),
     };
     finish(&study, &front, &optimised, timer, &out_dir)
 }
@@ -363,6 +366,7 @@ pub fn finish(
             shards: study.shards,
             date: utc_now(),
             timings: Vec::new(),
+            shard_timings: study.shard_timings.clone(),
             notes: Vec::new(),
         },
         serde_json::to_value(&model.case)?,

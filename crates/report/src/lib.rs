@@ -13,7 +13,7 @@
 //! let metadata = RunMetadata {
 //!     tool: "counterpoise".into(), tool_version: "0.1.0".into(),
 //!     case_name: "pendulum".into(), case_path: "cases/pendulum.json".into(),
-//!     dmax: 1, jobs: 2, shards: None, date: "2026-11-22T00:00:00Z".into(),
+//!     dmax: 1, jobs: 2, shards: None, shard_timings: Vec::new(), date: "2026-11-22T00:00:00Z".into(),
 //!     timings: vec![PhaseTiming { phase: "search".into(), seconds: 0.01 }], notes: vec![],
 //! };
 //! let eval = |qtr: f64| Evaluation {

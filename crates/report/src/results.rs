@@ -411,6 +411,10 @@ pub struct RunMetadata {
     /// Timestamp supplied by the caller (e.g. RFC 3339, UTC); kept verbatim.
     pub date: String,
     pub timings: Vec<PhaseTiming>,
+    /// For merged results, the phases of each shard (named `shard I/N: …`): they ran
+    /// elsewhere and in parallel, so they are not part of this run's wall time.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shard_timings: Vec<PhaseTiming>,
     /// Anything else the designer should know (e.g. "reactions are minimum-norm").
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,

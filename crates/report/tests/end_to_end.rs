@@ -139,6 +139,7 @@ fn sample() -> RunResults {
         dmax: 2,
         jobs: 2,
         shards: None,
+        shard_timings: Vec::new(),
         date: "2026-11-22T00:00:00Z".into(),
         timings: vec![
             PhaseTiming {
