@@ -42,7 +42,8 @@ def main():
         sys.exit(__doc__)
     a, b = load(sys.argv[1]), load(sys.argv[2])
     if a == b:
-        print(f"identical (timings, date, jobs and shards aside): {sys.argv[1]} = {sys.argv[2]}")
+        aside = ", ".join(f"metadata.{key}" for key in IGNORED)
+        print(f"identical ({aside} aside): {sys.argv[1]} = {sys.argv[2]}")
         return 0
     out = []
     differences(a, b, "", out)

@@ -4,15 +4,16 @@
 #   scripts/slurm/e2e.sh
 #
 # 1. installs Slurm and munge from the distribution's packages when they are missing
-#    (apt-get: slurmctld slurmd slurm-client munge; needs root — CI runs as root);
+#    (apt-get: slurmctld slurmd slurm-client munge, and python3 for compare.py; needs root —
+#    CI runs as root; the packages' services are kept from starting);
 # 2. starts munged, slurmctld and slurmd in the foreground of background jobs, with their key,
 #    sockets, state, spool, logs and pid files in a temporary directory (no systemd, no
 #    cgroups: proctrack/linuxproc, task/none), one node (this host, its CPUs and memory) in
 #    one partition;
 # 3. submits the study with scripts/slurm/submit.sh (a job array of shards and the dependent
 #    merge), waits for the merge, runs the same study as a single `counterpoise run`, and
-#    compares the two results.json with scripts/slurm/compare.py (timings, date, jobs and
-#    shards aside);
+#    compares the two results.json with scripts/slurm/compare.py (the run metadata: timings,
+#    shard_timings, date, jobs and shards aside);
 # 4. stops the daemons by their pids on exit, whatever happened.
 #
 # Fails (non-zero, saying why) if Slurm cannot be installed or started, a job fails, or the
@@ -36,21 +37,39 @@ fail() {
 }
 
 install_slurm() {
-    local missing=()
+    local missing=() packages=(slurmctld slurmd slurm-client munge)
     for cmd in slurmctld slurmd sbatch squeue sinfo scontrol munged; do
         command -v "$cmd" >/dev/null 2>&1 || missing+=("$cmd")
     done
+    # compare.py; a minimal Debian image has no Python
+    if ! command -v python3 >/dev/null 2>&1; then
+        missing+=(python3)
+        packages+=(python3)
+    fi
     if [[ ${#missing[@]} -eq 0 ]]; then
         return
     fi
-    say "not installed: ${missing[*]}; installing slurmctld slurmd slurm-client munge"
+    say "not installed: ${missing[*]}; installing ${packages[*]}"
     [[ $(id -u) -eq 0 ]] || fail "installing Slurm needs root (missing: ${missing[*]})"
     command -v apt-get >/dev/null 2>&1 ||
-        fail "apt-get not found: install slurmctld, slurmd, slurm-client and munge by hand"
+        fail "apt-get not found: install ${packages[*]} by hand"
     export DEBIAN_FRONTEND=noninteractive
-    apt-get update -q || fail "apt-get update failed (no package repository reachable?)"
-    apt-get install -y -q slurmctld slurmd slurm-client munge ||
-        fail "apt-get install slurmctld slurmd slurm-client munge failed"
+    # The packages' own services must not start (no systemd here, and a system slurmctld or
+    # slurmd would hold the ports): a policy-rc.d for the install, unless there is one.
+    local policy=/usr/sbin/policy-rc.d ours=0
+    if [[ ! -e $policy ]]; then
+        printf '#!/bin/sh\nexit 101\n' > "$policy" && chmod 755 "$policy" && ours=1
+    fi
+    local status=0
+    apt-get update -q || status=1
+    if [[ $status -eq 0 ]]; then
+        apt-get install -y -q "${packages[@]}" || status=2
+    fi
+    if [[ $ours -eq 1 ]]; then
+        rm -f "$policy"
+    fi
+    [[ $status -ne 1 ]] || fail "apt-get update failed (no package repository reachable?)"
+    [[ $status -ne 2 ]] || fail "apt-get install ${packages[*]} failed"
     for cmd in "${missing[@]}"; do
         command -v "$cmd" >/dev/null 2>&1 || fail "$cmd still missing after the install"
     done
