@@ -117,6 +117,23 @@ fn merged_palletizer_study_equals_the_single_run_for_one_two_and_three_shards() 
 }
 
 #[test]
+fn more_shards_than_balanced_variants_leave_empty_shards_that_still_merge() {
+    // two_link has 4 balanced variants (README's variants table): in 6 shards, two are empty
+    // and must still be written and merged; the second method is the single run
+    let dir = tempfile::tempdir().unwrap();
+    let case = "cases/two_link.json";
+    let single = run_single(case, &dir.path().join("single"), &[]);
+    assert_merge_equals_single(case, 6, &single, &[]);
+    let shards = dir.path().join("shards");
+    run_shard(case, "6/6", &shards, &[]);
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(shards.join("shard-6-of-6.json")).unwrap())
+            .unwrap();
+    assert_eq!(file["variants"], serde_json::json!([]));
+    assert_eq!(file["balanced"], serde_json::json!(4));
+}
+
+#[test]
 fn malformed_shard_specs_are_usage_errors_naming_the_spec() {
     for (spec, reason) in [
         ("3/2", "numbered 1 to 2"),
