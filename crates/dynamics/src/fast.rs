@@ -70,6 +70,28 @@ struct Work {
     /// Columns run innermost so that every task evaluation is a contiguous, vectorisable
     /// sweep. Reused from sub-task to sub-task (every value is overwritten).
     coefficients: Vec<f64>,
+    /// Running sums and peaks of [`task_stats`], reused from sub-task to sub-task (fresh
+    /// megabyte-sized buffers per sub-task cost more in page faults than the sums themselves).
+    stats: StatsScratch,
+}
+
+#[derive(Default)]
+struct StatsScratch {
+    sum_sq: Vec<f64>,
+    peak: Vec<f64>,
+    total_peak: Vec<f64>,
+    reaction_peak: Vec<f64>,
+    tau: Vec<f64>,
+    abs_sum: Vec<f64>,
+    /// A spent [`TaskRows`] buffer handed back for the next sub-task.
+    rows: Vec<f64>,
+}
+
+/// `v` as `n` zeros, reusing its allocation.
+fn zeroed(v: &mut Vec<f64>, n: usize) -> &mut [f64] {
+    v.clear();
+    v.resize(n, 0.0);
+    v
 }
 
 /// Parameter columns grouped by their inertial parameters (see the module doc).
@@ -320,6 +342,7 @@ pub(crate) fn evaluate_cyclic(
             params.len(),
             na,
             nj,
+            &mut work.stats,
         );
         Ok((rows, users[st].iter().map(|u| u.0).zip(slot).collect()))
     };
@@ -346,29 +369,30 @@ pub(crate) fn evaluate_cyclic(
             // Each worker folds its sub-tasks into its own maxima; the merge is order-free
             // (ties to the lowest task), so the result does not depend on the split.
             let empty = IndicatorAccumulator::new(acc.columns, acc.actuators, acc.joints);
-            let (maxima, failed, count) = (0..st_pairs.len())
+            let (_, maxima, failed, count) = (0..st_pairs.len())
                 .into_par_iter()
-                .map_init(Work::default, |work, st| one_sub_task(work, st))
                 .fold(
-                    || (empty.clone(), Vec::new(), 0usize),
-                    |(mut m, mut failed, mut count), outcome| {
-                        match outcome {
+                    || (Work::default(), empty.clone(), Vec::new(), 0usize),
+                    |(mut work, mut m, mut failed, mut count), st| {
+                        match one_sub_task(&mut work, st) {
                             Ok((rows, assignment)) => {
                                 count += rows.len();
                                 for (w, u) in assignment {
                                     m.add_rows(w, rows.task(u));
                                 }
+                                work.stats.rows = rows.data;
                             }
                             Err(f) => failed.extend(f),
                         }
-                        (m, failed, count)
+                        (work, m, failed, count)
                     },
                 )
+                .map(|(_, m, failed, count)| ((), m, failed, count))
                 .reduce(
-                    || (empty.clone(), Vec::new(), 0usize),
-                    |(m, mut f1, c1), (other, f2, c2)| {
+                    || ((), empty.clone(), Vec::new(), 0usize),
+                    |(_, m, mut f1, c1), (_, other, f2, c2)| {
                         f1.extend(f2);
-                        (m.merge(&other), f1, c1 + c2)
+                        ((), m.merge(&other), f1, c1 + c2)
                     },
                 );
             *acc = acc.clone().merge(&maxima);
@@ -392,17 +416,18 @@ fn task_stats(
     cols: usize,
     na: usize,
     nj: usize,
+    scratch: &mut StatsScratch,
 ) -> TaskRows {
     let nt = tasks.len();
     let tq = na * cols;
     let rq = 2 * nj * cols;
-    let mut sum_sq = vec![0.0f64; nt * tq];
-    let mut peak = vec![0.0f64; nt * tq];
-    let mut total_peak = vec![0.0f64; nt * cols];
+    let sum_sq = zeroed(&mut scratch.sum_sq, nt * tq);
+    let peak = zeroed(&mut scratch.peak, nt * tq);
+    let total_peak = zeroed(&mut scratch.total_peak, nt * cols);
     // peaks of |F|², |M|² (square roots taken once at the end)
-    let mut reaction_peak = vec![0.0f64; nt * rq];
-    let mut tau = vec![0.0f64; tq];
-    let mut abs_sum = vec![0.0f64; cols];
+    let reaction_peak = zeroed(&mut scratch.reaction_peak, nt * rq);
+    let tau = zeroed(&mut scratch.tau, tq);
+    let abs_sum = zeroed(&mut scratch.abs_sum, cols);
     for k in 0..ns {
         for (t, &(rev, delta)) in tasks.iter().enumerate() {
             let dd = if rev { -delta } else { delta };
@@ -430,7 +455,7 @@ fn task_stats(
                     *s += x.abs();
                 }
             }
-            for (m, &s) in total_peak[t * cols..(t + 1) * cols].iter_mut().zip(&abs_sum) {
+            for (m, &s) in total_peak[t * cols..(t + 1) * cols].iter_mut().zip(abs_sum.iter()) {
                 if s > *m {
                     *m = s;
                 }
@@ -452,7 +477,10 @@ fn task_stats(
     }
     let width = 2 * na + 1 + 2 * nj;
     let n = ns.max(1) as f64;
-    let mut data = vec![0.0; nt * cols * width];
+    // every value is written below
+    let mut data = std::mem::take(&mut scratch.rows);
+    data.clear();
+    data.resize(nt * cols * width, 0.0);
     for t in 0..nt {
         for p in 0..cols {
             let row = &mut data[(t * cols + p) * width..(t * cols + p + 1) * width];
@@ -701,7 +729,6 @@ fn sub_task(
             tc2[i] = 0.5 * (xp[i] + xm[i]) - x0[i];
         }
         if with_reactions {
-            reaction_coefs.fill(0.0);
             let (q0, rest) = reaction_coefs.split_at_mut(rq);
             let (q1, rest) = rest.split_at_mut(rq);
             let (q2, rest) = rest.split_at_mut(rq);
@@ -715,21 +742,38 @@ fn sub_task(
                         &mut q2[slot.clone()],
                     );
                     let (q3, q4) = (&mut q3[slot.clone()], &mut q4[slot]);
-                    for r in 0..3 {
+                    // the three components' rows at Δ = 0, +1, −1
+                    let component = |r: usize| {
                         let row = 6 * j + 3 * part + r;
                         let row = &reactions[row * m..(row + 1) * m];
                         let (x0, rest) = row.split_at(cols);
                         let (xp, xm) = rest.split_at(cols);
-                        for p in 0..cols {
+                        (x0, xp, xm)
+                    };
+                    let rows = [component(0), component(1), component(2)];
+                    for p in 0..cols {
+                        let mut sums = [0.0; 5];
+                        for (r, (x0, xp, xm)) in rows.iter().enumerate() {
                             let c0 = x0[p];
                             let c1 = 0.5 * (xp[p] - xm[p]);
                             let c2 = 0.5 * (xp[p] + xm[p]) - c0;
-                            q0[p] += c0 * c0;
-                            q1[p] += 2.0 * c0 * c1;
-                            q2[p] += c1 * c1 + 2.0 * c0 * c2;
-                            q3[p] += 2.0 * c1 * c2;
-                            q4[p] += c2 * c2;
+                            let terms = [
+                                c0 * c0,
+                                2.0 * c0 * c1,
+                                c1 * c1 + 2.0 * c0 * c2,
+                                2.0 * c1 * c2,
+                                c2 * c2,
+                            ];
+                            for (s, t) in sums.iter_mut().zip(terms) {
+                                // the first component is assigned, not added to zero
+                                *s = if r == 0 { t } else { *s + t };
+                            }
                         }
+                        q0[p] = sums[0];
+                        q1[p] = sums[1];
+                        q2[p] = sums[2];
+                        q3[p] = sums[3];
+                        q4[p] = sums[4];
                     }
                 }
             }
