@@ -15,14 +15,7 @@ use counterpoise_balance::{
 use counterpoise_model::Case;
 use counterpoise_optimise::{Context, OptimiseOptions, optimise_all};
 
-// Fails on this build: the grid evaluation in crates/dynamics takes a column's path and
-// arithmetic from the whole batch (the cyclic shortcut is off for every column as soon as one
-// has a spring to the base; spring slots are numbered in order of first use in the batch; the
-// inertia groups' representative is the batch's first column of the group; the per-column
-// Newton–Euler path is taken for batches of one or two). Merging the palletizer's shards
-// exactly needs it to pass.
 #[test]
-#[ignore = "crates/dynamics evaluates a column differently depending on its batch (see the comment)"]
 fn each_variant_optimises_to_the_same_bits_whatever_its_batch() {
     // The palletizer on a 3 × 3 × 3 grid with 11 samples per move: every structure the
     // dynamics batches over (counterweights, springs sharing the robot's inertia, the θ1

@@ -20,9 +20,11 @@
 //! Springs are static: their forces depend on `q` only, not on `Δ`. Two parameter columns
 //! with the same inertial parameters (every body block, counterweights included) therefore
 //! differ by a `Δ`-independent amount in every output, `X_p(Δ) = X_r(Δ) + X_p(0) − X_r(0)`.
-//! Columns are grouped by their inertial parameters; only the first column of each group is
-//! evaluated at `Δ = ±1`, the others at `Δ = 0` alone. Spring-only variants share the
-//! unbalanced robot's inertia, so a batch of them costs one third of the reaction solves.
+//! Columns are grouped by their inertial parameters; each group is represented by its inertia
+//! without springs, evaluated at `Δ ∈ {0, 1, −1}`, and the columns themselves at `Δ = 0` alone.
+//! Spring-only variants share the unbalanced robot's inertia, so a batch of them costs about
+//! one third of the reaction solves. The representative depends on the column alone, never on
+//! the rest of the batch, so a column's values are the same bits in any batch.
 
 use std::collections::HashMap;
 
@@ -31,9 +33,7 @@ use rayon::prelude::*;
 
 use crate::error::{FailureReason, TaskFailure};
 use crate::indicators::{IndicatorAccumulator, StatsTable};
-use crate::kernel::{
-    ColumnBatch, actuator_forces, actuator_forces_batch, required_wrenches, required_wrenches_batch,
-};
+use crate::kernel::{ColumnBatch, actuator_forces_batch, required_wrenches_batch};
 use crate::law::{quintic, quintic_move, sample_time};
 use crate::lu::SmallLu;
 use crate::mechanism::{BodyKin, Scratch};
@@ -50,7 +50,6 @@ struct Work {
     kin: Vec<BodyKin>,
     regressors: Vec<WrenchRegressor>,
     reactions_work: ReactionWork,
-    w: Vec<f64>,
     /// Required wrenches of a batch of columns, `[body row][column]`.
     wb: Vec<f64>,
     /// Actuator forces of a batch of columns, `[actuator][column]`.
@@ -70,62 +69,81 @@ struct Work {
     /// Columns run innermost so that every task evaluation is a contiguous, vectorisable
     /// sweep. Reused from sub-task to sub-task (every value is overwritten).
     coefficients: Vec<f64>,
+    /// Running sums and peaks of [`task_stats`], reused from sub-task to sub-task (fresh
+    /// megabyte-sized buffers per sub-task cost more in page faults than the sums themselves).
+    stats: StatsScratch,
+}
+
+#[derive(Default)]
+struct StatsScratch {
+    sum_sq: Vec<f64>,
+    peak: Vec<f64>,
+    total_peak: Vec<f64>,
+    reaction_peak: Vec<f64>,
+    tau: Vec<f64>,
+    abs_sum: Vec<f64>,
+    /// A spent [`TaskRows`] buffer handed back for the next sub-task.
+    rows: Vec<f64>,
+}
+
+/// `v` as `n` zeros, reusing its allocation.
+fn zeroed(v: &mut Vec<f64>, n: usize) -> &mut [f64] {
+    v.clear();
+    v.resize(n, 0.0);
+    v
 }
 
 /// Parameter columns grouped by their inertial parameters (see the module doc).
+///
+/// Each group is represented by a column of its own: the group's inertial parameters with no
+/// springs. A column's value at `Δ = ±1` is then `X_r(±1) + X_p(0) − X_r(0)` with `r` fixed by
+/// the column's inertia alone, so its bits do not depend on which other columns share the batch
+/// (a sharded study merges into exactly the single run's result).
 struct InertiaGroups {
     /// Every column, in order.
     all: ColumnBatch,
     /// Per column, its group.
     group: Vec<usize>,
-    /// Per group, its first column (the representative), as a batch.
+    /// The groups' spring-free representatives (one column per group).
+    rep_params: ParameterSet,
     rep_batch: ColumnBatch,
-    /// Per column, its representative.
-    rep_column: Vec<usize>,
 }
 
 impl InertiaGroups {
     fn new(params: &ParameterSet) -> InertiaGroups {
         let inertial = crate::params::BODY_PARAMS * params.bodies;
         let mut index: HashMap<Vec<u64>, usize> = HashMap::new();
-        let mut reps = Vec::new();
+        let mut rep_params = ParameterSet::empty(params.bodies, params.springs.clone());
         let group: Vec<usize> = (0..params.len())
             .map(|p| {
-                let key = params.column(p)[..inertial]
-                    .iter()
-                    .map(|x| x.to_bits())
-                    .collect();
+                let body_part = &params.column(p)[..inertial];
+                let key = body_part.iter().map(|x| x.to_bits()).collect();
                 *index.entry(key).or_insert_with(|| {
-                    reps.push(p);
-                    reps.len() - 1
+                    let mut column = body_part.to_vec();
+                    column.resize(params.rows(), 0.0);
+                    rep_params
+                        .push_column(&column)
+                        .expect("a column of the set's own shape");
+                    rep_params.len() - 1
                 })
             })
             .collect();
         let all: Vec<usize> = (0..params.len()).collect();
-        let rep_column = group.iter().map(|&g| reps[g]).collect();
+        let reps: Vec<usize> = (0..rep_params.len()).collect();
         InertiaGroups {
-            rep_column,
             all: ColumnBatch::new(params, &all),
             group,
-            rep_batch: ColumnBatch::new(params, &reps),
+            rep_batch: ColumnBatch::new(&rep_params, &reps),
+            rep_params,
         }
     }
 
     /// Every column's value from its representative's, `dst[p] = rep[g] + (zero[p] −
-    /// zero[r])` with `g` the column's group and `r` its representative, `zero` the values at
-    /// `Δ = 0`. When every column is its own group this is `rep` itself.
-    fn expand(&self, dst: &mut [f64], rep: &[f64], zero: &[f64]) {
-        if self.rep_batch.len() == self.group.len() {
-            dst.copy_from_slice(rep);
-            return;
-        }
-        for (((d, &g), &r), &z) in dst
-            .iter_mut()
-            .zip(&self.group)
-            .zip(&self.rep_column)
-            .zip(zero)
-        {
-            *d = rep[g] + (z - zero[r]);
+    /// rep_zero[g])` with `g` the column's group, `zero` the columns' values at `Δ = 0` and
+    /// `rep_zero` the representatives'.
+    fn expand(&self, dst: &mut [f64], rep: &[f64], zero: &[f64], rep_zero: &[f64]) {
+        for ((d, &g), &z) in dst.iter_mut().zip(&self.group).zip(zero) {
+            *d = rep[g] + (z - rep_zero[g]);
         }
     }
 }
@@ -320,6 +338,7 @@ pub(crate) fn evaluate_cyclic(
             params.len(),
             na,
             nj,
+            &mut work.stats,
         );
         Ok((rows, users[st].iter().map(|u| u.0).zip(slot).collect()))
     };
@@ -346,29 +365,30 @@ pub(crate) fn evaluate_cyclic(
             // Each worker folds its sub-tasks into its own maxima; the merge is order-free
             // (ties to the lowest task), so the result does not depend on the split.
             let empty = IndicatorAccumulator::new(acc.columns, acc.actuators, acc.joints);
-            let (maxima, failed, count) = (0..st_pairs.len())
+            let (_, maxima, failed, count) = (0..st_pairs.len())
                 .into_par_iter()
-                .map_init(Work::default, |work, st| one_sub_task(work, st))
                 .fold(
-                    || (empty.clone(), Vec::new(), 0usize),
-                    |(mut m, mut failed, mut count), outcome| {
-                        match outcome {
+                    || (Work::default(), empty.clone(), Vec::new(), 0usize),
+                    |(mut work, mut m, mut failed, mut count), st| {
+                        match one_sub_task(&mut work, st) {
                             Ok((rows, assignment)) => {
                                 count += rows.len();
                                 for (w, u) in assignment {
                                     m.add_rows(w, rows.task(u));
                                 }
+                                work.stats.rows = rows.data;
                             }
                             Err(f) => failed.extend(f),
                         }
-                        (m, failed, count)
+                        (work, m, failed, count)
                     },
                 )
+                .map(|(_, m, failed, count)| ((), m, failed, count))
                 .reduce(
-                    || (empty.clone(), Vec::new(), 0usize),
-                    |(m, mut f1, c1), (other, f2, c2)| {
+                    || ((), empty.clone(), Vec::new(), 0usize),
+                    |(_, m, mut f1, c1), (_, other, f2, c2)| {
                         f1.extend(f2);
-                        (m.merge(&other), f1, c1 + c2)
+                        ((), m.merge(&other), f1, c1 + c2)
                     },
                 );
             *acc = acc.clone().merge(&maxima);
@@ -392,17 +412,18 @@ fn task_stats(
     cols: usize,
     na: usize,
     nj: usize,
+    scratch: &mut StatsScratch,
 ) -> TaskRows {
     let nt = tasks.len();
     let tq = na * cols;
     let rq = 2 * nj * cols;
-    let mut sum_sq = vec![0.0f64; nt * tq];
-    let mut peak = vec![0.0f64; nt * tq];
-    let mut total_peak = vec![0.0f64; nt * cols];
+    let sum_sq = zeroed(&mut scratch.sum_sq, nt * tq);
+    let peak = zeroed(&mut scratch.peak, nt * tq);
+    let total_peak = zeroed(&mut scratch.total_peak, nt * cols);
     // peaks of |F|², |M|² (square roots taken once at the end)
-    let mut reaction_peak = vec![0.0f64; nt * rq];
-    let mut tau = vec![0.0f64; tq];
-    let mut abs_sum = vec![0.0f64; cols];
+    let reaction_peak = zeroed(&mut scratch.reaction_peak, nt * rq);
+    let tau = zeroed(&mut scratch.tau, tq);
+    let abs_sum = zeroed(&mut scratch.abs_sum, cols);
     for k in 0..ns {
         for (t, &(rev, delta)) in tasks.iter().enumerate() {
             let dd = if rev { -delta } else { delta };
@@ -430,7 +451,7 @@ fn task_stats(
                     *s += x.abs();
                 }
             }
-            for (m, &s) in total_peak[t * cols..(t + 1) * cols].iter_mut().zip(&abs_sum) {
+            for (m, &s) in total_peak[t * cols..(t + 1) * cols].iter_mut().zip(abs_sum.iter()) {
                 if s > *m {
                     *m = s;
                 }
@@ -452,7 +473,10 @@ fn task_stats(
     }
     let width = 2 * na + 1 + 2 * nj;
     let n = ns.max(1) as f64;
-    let mut data = vec![0.0; nt * cols * width];
+    // every value is written below
+    let mut data = std::mem::take(&mut scratch.rows);
+    data.clear();
+    data.resize(nt * cols * width, 0.0);
     for t in 0..nt {
         for p in 0..cols {
             let row = &mut data[(t * cols + p) * width..(t * cols + p + 1) * width];
@@ -504,8 +528,8 @@ fn sub_task(
     let tq = n * cols;
     let rq = 2 * nj * cols;
     let nreps = groups.rep_batch.len();
-    // right-hand sides solved: every column at Δ = 0, the representatives at Δ = ±1
-    let solved = cols + 2 * nreps;
+    // right-hand sides solved: every column at Δ = 0, the representatives at Δ = 0, ±1
+    let solved = cols + 3 * nreps;
     work.coefficients.resize(ns * stride, 0.0);
     let mut q = q0.to_vec();
     let mut u = [0.0; MAX_VARS];
@@ -513,9 +537,8 @@ fn sub_task(
     let mut udd = [0.0; MAX_VARS];
     let mut f = [0.0; MAX_VARS];
     let mut g = [0.0; MAX_VARS * MAX_VARS];
-    work.w.resize(rows, 0.0);
     work.torques.resize(3 * tq, 0.0);
-    work.rep_torques.resize(2 * n * nreps, 0.0);
+    work.rep_torques.resize(3 * n * nreps, 0.0);
     if with_reactions {
         work.b.resize(rows * solved, 0.0);
         work.out.resize(6 * nj * solved, 0.0);
@@ -553,46 +576,32 @@ fn sub_task(
                 qdd[a] -= bias[a];
             }
             lu.solve(&mut qdd);
-            let batch = if si == 0 {
-                &groups.all
-            } else {
-                &groups.rep_batch
-            };
-            let nc = batch.len();
-            // the batch's first right-hand side among those solved
-            let first = if si == 0 { 0 } else { cols + (si - 1) * nreps };
-            // With several columns, one wrench regressor per body serves them all and the
-            // columns are evaluated together; with one or two, the direct Newton–Euler wrench
-            // per column is cheaper.
-            let shared = nc > 2;
             work.regressors.clear();
             for (b, kin) in work.kin.iter_mut().enumerate() {
                 mech.set_motion(&pose, b, kin, &qd, &qdd);
-                if shared {
-                    work.regressors.push(wrench_regressor(kin, &mech.gravity));
-                }
+                work.regressors.push(wrench_regressor(kin, &mech.gravity));
             }
-            let mut store_torques = |c: usize, qu: &[f64; MAX_VARS]| {
-                for a in 0..n {
-                    let torque = qu[a] * ev.ratios[a];
-                    if si == 0 {
-                        work.torques[a * cols + c] = torque;
-                    } else {
-                        work.rep_torques[((si - 1) * n + a) * nreps + c] = torque;
-                    }
-                }
+            // Every column at Δ = 0; the representatives at every Δ. One wrench regressor per
+            // body serves all the columns of a batch, whatever its size, so that a column's
+            // arithmetic is the same in every batch.
+            let representatives = (true, &groups.rep_batch);
+            let jobs: &[(bool, &ColumnBatch)] = if si == 0 {
+                &[(false, &groups.all), representatives]
+            } else {
+                &[representatives]
             };
-            if shared {
+            for &(is_rep, batch) in jobs {
+                let nc = batch.len();
+                // the batch's first right-hand side among those solved
+                let first = if is_rep { cols + si * nreps } else { 0 };
+                let slots = if is_rep {
+                    &groups.rep_params.springs
+                } else {
+                    &params.springs
+                };
                 work.wb.resize(rows * nc, 0.0);
                 work.qb.resize(n * nc, 0.0);
-                required_wrenches_batch(
-                    mech,
-                    &pose,
-                    &work.regressors,
-                    &params.springs,
-                    batch,
-                    &mut work.wb,
-                );
+                required_wrenches_batch(mech, &pose, &work.regressors, slots, batch, &mut work.wb);
                 actuator_forces_batch(
                     &work.kin,
                     &work.wb,
@@ -607,7 +616,14 @@ fn sub_task(
                     for a in 0..n {
                         qu[a] = work.qb[a * nc + c];
                     }
-                    store_torques(c, &qu);
+                    for a in 0..n {
+                        let torque = qu[a] * ev.ratios[a];
+                        if is_rep {
+                            work.rep_torques[(si * n + a) * nreps + c] = torque;
+                        } else {
+                            work.torques[a * cols + c] = torque;
+                        }
+                    }
                     if with_reactions {
                         ev.reactions.subtract_actuators(
                             &work.reactions_work,
@@ -624,24 +640,6 @@ fn sub_task(
                             .copy_from_slice(&work.wb[r * nc..(r + 1) * nc]);
                     }
                 }
-            } else {
-                for (c, &p) in batch.columns.iter().enumerate() {
-                    required_wrenches(mech, &pose, &work.kin, params, p, &mut work.w);
-                    let qu = actuator_forces(&work.kin, &work.w, n, &lu);
-                    store_torques(c, &qu);
-                    if with_reactions {
-                        ev.reactions.subtract_actuators(
-                            &work.reactions_work,
-                            &work.kin,
-                            &qu,
-                            &mut work.w,
-                            1,
-                        );
-                        for r in 0..rows {
-                            work.b[r * solved + first + c] = work.w[r];
-                        }
-                    }
-                }
             }
         }
         if with_reactions {
@@ -653,16 +651,16 @@ fn sub_task(
             );
         }
         work.scratch.pose = pose;
-        // Every column at Δ = ±1 from its representative: X_p(±1) = X_r(±1) + X_p(0) − X_r(0)
-        // (exact for the representative itself).
+        // Every column at Δ = ±1 from its representative: X_p(±1) = X_r(±1) + X_p(0) − X_r(0).
         {
             let (at_zero, at_pm) = work.torques.split_at_mut(tq);
             for si in 0..2 {
                 for a in 0..n {
                     let zero = &at_zero[a * cols..(a + 1) * cols];
-                    let rep = &work.rep_torques[(si * n + a) * nreps..(si * n + a + 1) * nreps];
+                    let reps =
+                        |d: usize| &work.rep_torques[(d * n + a) * nreps..(d * n + a + 1) * nreps];
                     let dst = &mut at_pm[(si * n + a) * cols..(si * n + a + 1) * cols];
-                    groups.expand(dst, rep, zero);
+                    groups.expand(dst, reps(si + 1), zero, reps(0));
                 }
             }
         }
@@ -671,10 +669,15 @@ fn sub_task(
                 let src = &work.out[row * solved..(row + 1) * solved];
                 let dst = &mut work.reactions[row * m..(row + 1) * m];
                 let zero = &src[..cols];
+                let reps = |d: usize| &src[cols + d * nreps..cols + (d + 1) * nreps];
                 dst[..cols].copy_from_slice(zero);
                 for si in 0..2 {
-                    let rep = &src[cols + si * nreps..cols + (si + 1) * nreps];
-                    groups.expand(&mut dst[(si + 1) * cols..(si + 2) * cols], rep, zero);
+                    groups.expand(
+                        &mut dst[(si + 1) * cols..(si + 2) * cols],
+                        reps(si + 1),
+                        zero,
+                        reps(0),
+                    );
                 }
             }
         }
@@ -701,7 +704,6 @@ fn sub_task(
             tc2[i] = 0.5 * (xp[i] + xm[i]) - x0[i];
         }
         if with_reactions {
-            reaction_coefs.fill(0.0);
             let (q0, rest) = reaction_coefs.split_at_mut(rq);
             let (q1, rest) = rest.split_at_mut(rq);
             let (q2, rest) = rest.split_at_mut(rq);
@@ -715,21 +717,38 @@ fn sub_task(
                         &mut q2[slot.clone()],
                     );
                     let (q3, q4) = (&mut q3[slot.clone()], &mut q4[slot]);
-                    for r in 0..3 {
+                    // the three components' rows at Δ = 0, +1, −1
+                    let component = |r: usize| {
                         let row = 6 * j + 3 * part + r;
                         let row = &reactions[row * m..(row + 1) * m];
                         let (x0, rest) = row.split_at(cols);
                         let (xp, xm) = rest.split_at(cols);
-                        for p in 0..cols {
+                        (x0, xp, xm)
+                    };
+                    let rows = [component(0), component(1), component(2)];
+                    for p in 0..cols {
+                        let mut sums = [0.0; 5];
+                        for (r, (x0, xp, xm)) in rows.iter().enumerate() {
                             let c0 = x0[p];
                             let c1 = 0.5 * (xp[p] - xm[p]);
                             let c2 = 0.5 * (xp[p] + xm[p]) - c0;
-                            q0[p] += c0 * c0;
-                            q1[p] += 2.0 * c0 * c1;
-                            q2[p] += c1 * c1 + 2.0 * c0 * c2;
-                            q3[p] += 2.0 * c1 * c2;
-                            q4[p] += c2 * c2;
+                            let terms = [
+                                c0 * c0,
+                                2.0 * c0 * c1,
+                                c1 * c1 + 2.0 * c0 * c2,
+                                2.0 * c1 * c2,
+                                c2 * c2,
+                            ];
+                            for (s, t) in sums.iter_mut().zip(terms) {
+                                // the first component is assigned, not added to zero
+                                *s = if r == 0 { t } else { *s + t };
+                            }
                         }
+                        q0[p] = sums[0];
+                        q1[p] = sums[1];
+                        q2[p] = sums[2];
+                        q3[p] = sums[3];
+                        q4[p] = sums[4];
                     }
                 }
             }

@@ -13,7 +13,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::lu::SmallLu;
 use crate::mechanism::{BodyKin, Mechanism};
 use crate::params::{BODY_PARAMS, ParameterSet, SPRING_PARAMS, SpringSlot};
-use crate::regressor::{WrenchRegressor, spring_wrenches};
+use crate::regressor::{SpringFrame, WrenchRegressor, spring_wrenches};
 
 /// Symmetric inertia from `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]`.
 #[inline]
@@ -71,7 +71,18 @@ fn subtract_spring(
     w: &mut [f64],
     stride: usize,
 ) {
-    let (fi, ni, fs, ns) = spring_wrenches(mech, pose, slot, x);
+    subtract_spring_with(slot, spring_wrenches(mech, pose, slot, x), w, stride);
+}
+
+/// Subtracts the wrenches `(F_i, N_i, F_s, N_s)` of a spring in `slot` (see
+/// [`subtract_spring`]).
+#[inline]
+fn subtract_spring_with(
+    slot: &SpringSlot,
+    (fi, ni, fs, ns): (Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>),
+    w: &mut [f64],
+    stride: usize,
+) {
     for r in 0..3 {
         w[(6 * slot.body + r) * stride] -= fi[r];
         w[(6 * slot.body + 3 + r) * stride] -= ni[r];
@@ -99,11 +110,11 @@ fn subtract_springs(
 }
 
 /// Like [`required_wrenches`] from precomputed wrench regressors of the bodies (cheaper when
-/// many columns share one motion): `w_i = W_i π_i` minus spring forces.
+/// many columns share one motion): `w_i = W_i π_i` minus spring forces, with `frames` the
+/// [`SpringFrame`] of every slot of `params` at this pose.
 pub fn required_wrenches_with(
-    mech: &Mechanism,
-    pose: &[f64],
     regressors: &[WrenchRegressor],
+    frames: &[SpringFrame],
     params: &ParameterSet,
     column: usize,
     w: &mut [f64],
@@ -120,7 +131,17 @@ pub fn required_wrenches_with(
             w[6 * i + r] = acc;
         }
     }
-    subtract_springs(mech, pose, &params.springs, &col[BODY_PARAMS * l..], w);
+    let springs = &col[BODY_PARAMS * l..];
+    for ((slot, frame), x) in params
+        .springs
+        .iter()
+        .zip(frames)
+        .zip(springs.chunks_exact(SPRING_PARAMS))
+    {
+        if x.iter().any(|&v| v != 0.0) {
+            subtract_spring_with(slot, frame.wrenches(x), w, 1);
+        }
+    }
 }
 
 /// `Q_q = Σ_i J_v,iᵀ F_i + J_ω,iᵀ N_i`, then `Q_u = G⁻ᵀ Q_q` (returned).
@@ -279,9 +300,12 @@ pub fn required_wrenches_batch(
             }
         }
     }
+    // The frames of every slot a column uses, once for the whole batch.
+    let mut frames: Vec<Option<SpringFrame>> = vec![None; slots.len()];
     for (p, springs) in batch.springs.iter().enumerate() {
         for (s, x) in springs {
-            subtract_spring(mech, pose, &slots[*s], x, &mut w[p..], nc);
+            let frame = frames[*s].get_or_insert_with(|| SpringFrame::new(mech, pose, &slots[*s]));
+            subtract_spring_with(&slots[*s], frame.wrenches(x), &mut w[p..], nc);
         }
     }
 }

@@ -211,7 +211,8 @@ impl ParameterSet {
     }
 
     /// One column per variant: the model plus that variant's elements. Spring slots are the
-    /// distinct pairs used by any variant, in order of first use.
+    /// distinct pairs used by any variant, ordered by body and then the other body (base
+    /// first).
     pub fn from_variants(
         model: &Model,
         variants: &[Variant],
@@ -235,6 +236,9 @@ impl ParameterSet {
                 }
             }
         }
+        // In a fixed order, whatever the batch: a column's springs are applied slot after slot,
+        // so the order is part of its arithmetic.
+        slots.sort_by_key(|s| (s.body, s.other));
         let mut set = ParameterSet::empty(l, slots);
         let base = model_body_params(model);
         for v in variants {

@@ -33,7 +33,7 @@ use crate::kernel::required_wrenches_with;
 use crate::lu::SmallLu;
 use crate::mechanism::{BodyKin, Mechanism, Scratch};
 use crate::params::ParameterSet;
-use crate::regressor::SampleRegressor;
+use crate::regressor::{SampleRegressor, SpringFrame};
 
 /// Relative singular-value threshold of the pseudo-inverse.
 pub const RANK_TOLERANCE: f64 = 1e-10;
@@ -342,8 +342,13 @@ impl ReactionSolver {
         self.prepare(mech, pose, kin, lu, work);
         let mut w = vec![0.0; rows];
         let mut b = vec![0.0; rows * m];
+        let frames: Vec<SpringFrame> = params
+            .springs
+            .iter()
+            .map(|slot| SpringFrame::new(mech, pose, slot))
+            .collect();
         for (c, &p) in columns.iter().enumerate() {
-            required_wrenches_with(mech, pose, &reg.wrench, params, p, &mut w);
+            required_wrenches_with(&reg.wrench, &frames, params, p, &mut w);
             self.subtract_actuators(work, kin, &actuator_forces[c], &mut w, 1);
             for (r, &x) in w.iter().enumerate() {
                 b[r * m + c] = x;

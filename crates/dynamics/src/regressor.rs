@@ -108,6 +108,61 @@ pub fn spring_regressor(mech: &Mechanism, pose: &[f64], slot: &SpringSlot, out: 
     }
 }
 
+/// The pose-dependent part of a spring slot's applied wrenches at one configuration: the two
+/// frames, `Δp`, and the linear map from `W` to the moment of the coupling term. Computed once
+/// per sample and slot, then applied to every column's lifted parameters
+/// ([`SpringFrame::wrenches`]).
+#[derive(Clone, Copy, Debug)]
+pub struct SpringFrame {
+    ri: Matrix3<f64>,
+    rs: Matrix3<f64>,
+    dp: Vector3<f64>,
+    /// `c_k = Σ_jl cross[k][3j + l] W_jl`, the axial vector of `R_i W R_sᵀ − (R_i W R_sᵀ)ᵀ`.
+    cross: [[f64; 9]; 3],
+}
+
+impl SpringFrame {
+    pub fn new(mech: &Mechanism, pose: &[f64], slot: &SpringSlot) -> SpringFrame {
+        let (ri, pi) = mech.pose_of(pose, BodyId::Body(slot.body));
+        let (rs, ps) = mech.pose_of(pose, slot.other.map_or(BodyId::Base, BodyId::Body));
+        // m_ab = Σ_jl R_i[a,j] W_jl R_s[b,l]; the axial vector is (m_12 − m_21, m_20 − m_02,
+        // m_01 − m_10).
+        let mut cross = [[0.0; 9]; 3];
+        for (k, (a, b)) in [(1, 2), (2, 0), (0, 1)].into_iter().enumerate() {
+            for j in 0..3 {
+                for l in 0..3 {
+                    cross[k][3 * j + l] = ri[(a, j)] * rs[(b, l)] - ri[(b, j)] * rs[(a, l)];
+                }
+            }
+        }
+        SpringFrame {
+            ri,
+            rs,
+            dp: pi - ps,
+            cross,
+        }
+    }
+
+    /// Applied wrenches of the spring with lifted parameters `x` on its two bodies (world axes,
+    /// moments about each body's frame origin): `(F_i, N_i, F_s, N_s)`.
+    #[inline]
+    pub fn wrenches(&self, x: &[f64]) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        let k = x[0];
+        let alpha = self.ri * Vector3::new(x[1], x[2], x[3]);
+        let beta = self.rs * Vector3::new(x[4], x[5], x[6]);
+        let w = &x[7..16];
+        let axial = |row: &[f64; 9]| row.iter().zip(w).map(|(c, v)| c * v).sum::<f64>();
+        let cross = Vector3::new(
+            axial(&self.cross[0]),
+            axial(&self.cross[1]),
+            axial(&self.cross[2]),
+        );
+        let dp = self.dp;
+        let kd = dp * k + alpha - beta;
+        (-kd, -alpha.cross(&dp) + cross, kd, beta.cross(&dp) - cross)
+    }
+}
+
 /// Applied wrenches of a spring with lifted parameters `x` on its two bodies (world axes,
 /// moments about each body's frame origin): `(F_i, N_i, F_s, N_s)`.
 pub fn spring_wrenches(
@@ -116,21 +171,7 @@ pub fn spring_wrenches(
     slot: &SpringSlot,
     x: &[f64],
 ) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
-    let (ri, pi) = mech.pose_of(pose, BodyId::Body(slot.body));
-    let (rs, ps) = mech.pose_of(pose, slot.other.map_or(BodyId::Base, BodyId::Body));
-    let dp = pi - ps;
-    let k = x[0];
-    let alpha = ri * Vector3::new(x[1], x[2], x[3]);
-    let beta = rs * Vector3::new(x[4], x[5], x[6]);
-    let w = Matrix3::new(x[7], x[8], x[9], x[10], x[11], x[12], x[13], x[14], x[15]);
-    let m = ri * w * rs.transpose();
-    let cross = Vector3::new(
-        m[(1, 2)] - m[(2, 1)],
-        m[(2, 0)] - m[(0, 2)],
-        m[(0, 1)] - m[(1, 0)],
-    );
-    let kd = dp * k + alpha - beta;
-    (-kd, -alpha.cross(&dp) + cross, kd, beta.cross(&dp) - cross)
+    SpringFrame::new(mech, pose, slot).wrenches(x)
 }
 
 /// Per-sample regressor workspace: body kinematics and `Y` (`n × rows`, row-major).

@@ -553,9 +553,45 @@ fn dynamics_variant(problem: &VariantProblem, c: &Candidate) -> Variant {
     }
 }
 
+/// The all-task indicators of each variant.
+///
+/// The dynamics crate evaluates a batch through the cyclic shortcut only when no variant of it
+/// has a spring to the base (such a spring breaks the symmetry). Variants with one are
+/// evaluated in a batch of their own, so that every variant takes the same path, and gets the
+/// same bits, whatever else is optimised with it — a sharded study merges exactly.
+fn grid_indicators(
+    ctx: &Context,
+    variants: &[Variant],
+    reactions: bool,
+) -> Result<Vec<Indicators>, String> {
+    let to_base: Vec<bool> = variants
+        .iter()
+        .map(|v| v.springs.iter().any(|s| s.other.is_none()))
+        .collect();
+    if to_base.iter().all(|&b| b) || to_base.iter().all(|&b| !b) {
+        return batch_indicators(ctx, variants, reactions);
+    }
+    let part = |base: bool| -> Result<Vec<Indicators>, String> {
+        let members: Vec<Variant> = variants
+            .iter()
+            .zip(&to_base)
+            .filter(|(_, b)| **b == base)
+            .map(|(v, _)| v.clone())
+            .collect();
+        batch_indicators(ctx, &members, reactions)
+    };
+    let (mut with_base, mut without) = (part(true)?.into_iter(), part(false)?.into_iter());
+    Ok(to_base
+        .iter()
+        .map(|&b| {
+            if b { with_base.next() } else { without.next() }.expect("one result per variant")
+        })
+        .collect())
+}
+
 // Built from the default and then set: fields the dynamics crate adds keep their defaults.
 #[allow(clippy::field_reassign_with_default)]
-fn grid_indicators(
+fn batch_indicators(
     ctx: &Context,
     variants: &[Variant],
     reactions: bool,

@@ -109,6 +109,57 @@ fn lifted_with(
     out
 }
 
+/// Residual rows and Jacobian of one point, built in place (the Levenberg–Marquardt loop
+/// evaluates thousands of points per variant, so the rows are written into reused buffers
+/// instead of being collected from per-row vectors).
+struct Rows {
+    unknowns: usize,
+    /// Residual values.
+    r: Vec<f64>,
+    /// Jacobian, row-major (`r.len() × unknowns`).
+    jac: Vec<f64>,
+    /// Largest hinge value, and 0.
+    hinge_max: f64,
+}
+
+impl Rows {
+    fn new(unknowns: usize) -> Rows {
+        Rows {
+            unknowns,
+            r: Vec::new(),
+            jac: Vec::new(),
+            hinge_max: 0.0,
+        }
+    }
+
+    /// Appends a row of zeros with residual `value` and returns its Jacobian row.
+    fn push(&mut self, value: f64) -> &mut [f64] {
+        self.r.push(value);
+        let n = self.jac.len();
+        self.jac.resize(n + self.unknowns, 0.0);
+        &mut self.jac[n..]
+    }
+
+    /// A bound hinge `max(value, 0)`, with gradient `grad` where it is active.
+    fn hinge(&mut self, value: f64, grad: &[(usize, f64)]) {
+        self.hinge_max = self.hinge_max.max(value);
+        let row = self.push(value.max(0.0));
+        if value > 0.0 {
+            for &(j, g) in grad {
+                row[j] = g;
+            }
+        }
+    }
+
+    fn vector(&self) -> DVector<f64> {
+        DVector::from_column_slice(&self.r)
+    }
+
+    fn matrix(&self) -> DMatrix<f64> {
+        DMatrix::from_row_slice(self.r.len(), self.unknowns, &self.jac)
+    }
+}
+
 /// Residual rows and Jacobian: balance (relative to ‖b‖), bound hinges, optional pull.
 fn residual(
     problem: &VariantProblem,
@@ -123,16 +174,17 @@ fn residual(
     let xl = lifted_with(problem, x, lay, y);
     let rows = a.nrows();
     let balance = (a * &xl + b) * scale;
-    let mut r_rows: Vec<f64> = balance.iter().copied().collect();
-    let mut jac_rows: Vec<Vec<f64>> = vec![vec![0.0; lay.unknowns]; rows];
-    let mut hinge_max = 0.0f64;
+    let n_unknowns = lay.unknowns;
+    let mut out = Rows::new(n_unknowns);
+    out.r.extend(balance.iter().copied());
+    out.jac.resize(rows * n_unknowns, 0.0);
+    let mut d = vec![0.0; rows];
     for (k, s) in problem.springs.iter().enumerate() {
         let u = lay.start[k];
         let (na, nb) = (s.axes_a.len(), s.axes_b.len());
         let kk = y[u].exp();
-        let av: Vec<f64> = (0..na).map(|i| y[u + 1 + i]).collect();
-        let bv: Vec<f64> = (0..nb).map(|l| y[u + 1 + na + l]).collect();
-        let col = |j: usize| a.column(s.column + j);
+        let av = &y.as_slice()[u + 1..u + 1 + na];
+        let bv = &y.as_slice()[u + 1 + na..u + 1 + na + nb];
         // d/d ln K: the spring's own lifted vector
         let own = s.column..s.column + s.lifted_len();
         for row in 0..rows {
@@ -140,59 +192,59 @@ fn residual(
             for j in own.clone() {
                 dk += a[(row, j)] * xl[j];
             }
-            jac_rows[row][u] = dk * scale;
+            out.jac[row * n_unknowns + u] = dk * scale;
         }
         for i in 0..na {
-            let mut d = col(1 + i) * kk;
+            let c0 = a.column(s.column + 1 + i);
+            for row in 0..rows {
+                d[row] = c0[row] * kk;
+            }
             for l in 0..nb {
-                d += col(1 + na + nb + i * nb + l) * (kk * bv[l]);
+                let c = a.column(s.column + 1 + na + nb + i * nb + l);
+                let f = kk * bv[l];
+                for row in 0..rows {
+                    d[row] += c[row] * f;
+                }
             }
             for row in 0..rows {
-                jac_rows[row][u + 1 + i] = d[row] * scale;
+                out.jac[row * n_unknowns + u + 1 + i] = d[row] * scale;
             }
         }
         for l in 0..nb {
-            let mut d = col(1 + na + l) * kk;
+            let c0 = a.column(s.column + 1 + na + l);
+            for row in 0..rows {
+                d[row] = c0[row] * kk;
+            }
             for i in 0..na {
-                d += col(1 + na + nb + i * nb + l) * (kk * av[i]);
+                let c = a.column(s.column + 1 + na + nb + i * nb + l);
+                let f = kk * av[i];
+                for row in 0..rows {
+                    d[row] += c[row] * f;
+                }
             }
             for row in 0..rows {
-                jac_rows[row][u + 1 + na + l] = d[row] * scale;
+                out.jac[row * n_unknowns + u + 1 + na + l] = d[row] * scale;
             }
         }
         // Bound hinges.
         let [klo, khi] = s.bounds.stiffness;
-        let mut hinge = |value: f64, grad: Vec<(usize, f64)>| {
-            hinge_max = hinge_max.max(value);
-            let mut row = vec![0.0; lay.unknowns];
-            if value > 0.0 {
-                for (j, g) in grad {
-                    row[j] = g;
-                }
-            }
-            r_rows.push(value.max(0.0));
-            jac_rows.push(row);
-        };
         if klo > 0.0 {
-            hinge(klo.ln() - y[u], vec![(u, -1.0)]);
+            out.hinge(klo.ln() - y[u], &[(u, -1.0)]);
         }
-        hinge(y[u] - khi.ln(), vec![(u, 1.0)]);
+        out.hinge(y[u] - khi.ln(), &[(u, 1.0)]);
         for (range, offset, n) in [(s.bounds.anchor_a, 1, na), (s.bounds.anchor_b, 1 + na, nb)] {
-            let v: Vec<f64> = (0..n).map(|i| y[u + offset + i]).collect();
-            let len = norm(&v);
+            let v = &y.as_slice()[u + offset..u + offset + n];
+            let len = norm(v);
             let l = range[1].max(1e-3);
-            let unit: Vec<f64> = v
-                .iter()
-                .map(|c| if len > 0.0 { c / len } else { 0.0 })
-                .collect();
-            hinge(
-                (range[0] - len) / l,
-                (0..n).map(|i| (u + offset + i, -unit[i] / l)).collect(),
-            );
-            hinge(
-                (len - range[1]) / l,
-                (0..n).map(|i| (u + offset + i, unit[i] / l)).collect(),
-            );
+            let mut low = [(0usize, 0.0f64); 3];
+            let mut high = [(0usize, 0.0f64); 3];
+            for i in 0..n {
+                let unit = if len > 0.0 { v[i] / len } else { 0.0 };
+                low[i] = (u + offset + i, -unit / l);
+                high[i] = (u + offset + i, unit / l);
+            }
+            out.hinge((range[0] - len) / l, &low[..n]);
+            out.hinge((len - range[1]) / l, &high[..n]);
         }
         // Anchor boxes per body-frame axis.
         for (bx, axes, offset, reach) in [
@@ -204,10 +256,10 @@ fn residual(
                 let [lo, hi] = bx[axis];
                 let c = y[u + offset + i];
                 if lo.is_finite() {
-                    hinge((lo - c) / l, vec![(u + offset + i, -1.0 / l)]);
+                    out.hinge((lo - c) / l, &[(u + offset + i, -1.0 / l)]);
                 }
                 if hi.is_finite() {
-                    hinge((c - hi) / l, vec![(u + offset + i, 1.0 / l)]);
+                    out.hinge((c - hi) / l, &[(u + offset + i, 1.0 / l)]);
                 }
             }
         }
@@ -215,81 +267,40 @@ fn residual(
     for (c, &u) in problem.counterweights.iter().zip(&lay.cw_start) {
         let (big_m, big_r) = cw_scales(c);
         for row in 0..rows {
-            jac_rows[row][u] = a[(row, c.column)] * big_m * scale;
+            out.jac[row * n_unknowns + u] = a[(row, c.column)] * big_m * scale;
             for k in 0..c.axes.len() {
-                jac_rows[row][u + 1 + k] = a[(row, c.column + 1 + k)] * big_r * scale;
+                out.jac[row * n_unknowns + u + 1 + k] = a[(row, c.column + 1 + k)] * big_r * scale;
             }
         }
         let n = c.axes.len();
-        let mu: Vec<f64> = (0..n).map(|k| y[u + 1 + k]).collect();
-        let len = norm(&mu);
-        let unit: Vec<f64> = mu
-            .iter()
-            .map(|v| if len > 0.0 { v / len } else { 0.0 })
-            .collect();
-        let rows_of = |value: f64,
-                       grad: Vec<(usize, f64)>,
-                       r: &mut Vec<f64>,
-                       j: &mut Vec<Vec<f64>>,
-                       h: &mut f64| {
-            *h = h.max(value);
-            let mut row = vec![0.0; lay.unknowns];
-            if value > 0.0 {
-                for (k, g) in grad {
-                    row[k] = g;
-                }
-            }
-            r.push(value.max(0.0));
-            j.push(row);
-        };
+        let mu = &y.as_slice()[u + 1..u + 1 + n];
+        let len = norm(mu);
+        let unit = |k: usize| if len > 0.0 { mu[k] / len } else { 0.0 };
         let [mlo, mhi] = [c.min_mass() / big_m, c.bounds.mass[1] / big_m];
-        rows_of(
-            mlo - y[u],
-            vec![(u, -1.0)],
-            &mut r_rows,
-            &mut jac_rows,
-            &mut hinge_max,
-        );
-        rows_of(
-            y[u] - mhi,
-            vec![(u, 1.0)],
-            &mut r_rows,
-            &mut jac_rows,
-            &mut hinge_max,
-        );
+        out.hinge(mlo - y[u], &[(u, -1.0)]);
+        out.hinge(y[u] - mhi, &[(u, 1.0)]);
         let hi = c.bounds.radius[1] * big_m / big_r;
         let lo = c.bounds.radius[0] * big_m / big_r;
-        let mut grad: Vec<(usize, f64)> = (0..n).map(|k| (u + 1 + k, unit[k])).collect();
-        grad.push((u, -hi));
-        rows_of(
-            len - hi * y[u],
-            grad,
-            &mut r_rows,
-            &mut jac_rows,
-            &mut hinge_max,
-        );
-        let mut grad: Vec<(usize, f64)> = (0..n).map(|k| (u + 1 + k, -unit[k])).collect();
-        grad.push((u, lo));
-        rows_of(
-            lo * y[u] - len,
-            grad,
-            &mut r_rows,
-            &mut jac_rows,
-            &mut hinge_max,
-        );
+        let mut grad = [(0usize, 0.0f64); 4];
+        for k in 0..n {
+            grad[k] = (u + 1 + k, unit(k));
+        }
+        grad[n] = (u, -hi);
+        out.hinge(len - hi * y[u], &grad[..n + 1]);
+        for k in 0..n {
+            grad[k] = (u + 1 + k, -unit(k));
+        }
+        grad[n] = (u, lo);
+        out.hinge(lo * y[u] - len, &grad[..n + 1]);
     }
     let balance_norm = balance.norm();
     if let Some((target, weight)) = pull {
-        for j in 0..lay.unknowns {
-            let mut row = vec![0.0; lay.unknowns];
-            row[j] = weight;
-            r_rows.push(weight * (y[j] - target[j]));
-            jac_rows.push(row);
+        for j in 0..n_unknowns {
+            let value = weight * (y[j] - target[j]);
+            out.push(value)[j] = weight;
         }
     }
-    let r = DVector::from_vec(r_rows);
-    let jac = DMatrix::from_fn(jac_rows.len(), lay.unknowns, |i, j| jac_rows[i][j]);
-    (r, jac, balance_norm, hinge_max)
+    (out.vector(), out.matrix(), balance_norm, out.hinge_max)
 }
 
 fn levenberg_marquardt(
