@@ -103,10 +103,9 @@ fn merged_two_link_study_equals_the_single_run_for_one_two_and_three_shards() {
 }
 
 /// Exact merging of the palletizer needs every variant's optimisation to be independent of the
-/// other variants in its batch; the dynamics' grid evaluation is not yet (see
-/// tests/batch_independence.rs): run with `--ignored` once it is.
+/// other variants in its batch (tests/batch_independence.rs): counterweights, springs sharing
+/// the robot's inertia, springs to the base and the rotation about gravity are all there.
 #[test]
-#[ignore = "the grid evaluation of crates/dynamics depends on the batch of variants (tests/batch_independence.rs)"]
 fn merged_palletizer_study_equals_the_single_run_for_one_two_and_three_shards() {
     let dir = tempfile::tempdir().unwrap();
     let case = write_case(dir.path(), "palletizer.json", &reduced_palletizer(3, 11));
