@@ -161,6 +161,82 @@ pub fn shard_variants(variants: &[VariantResult], spec: ShardSpec) -> Vec<usize>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use counterpoise_balance::search::ElementRef;
+    use counterpoise_balance::{Class, Decision, Status};
+
+    /// A variant of the given element kinds and family dimension; the other fields are not
+    /// read by the cost model.
+    fn variant(kinds: &[&'static str], nullity: usize, status: Status) -> VariantResult {
+        VariantResult {
+            elements: kinds
+                .iter()
+                .enumerate()
+                .map(|(entry, &kind)| ElementRef {
+                    entry,
+                    label: format!("E{entry}"),
+                    kind,
+                    bodies: Vec::new(),
+                })
+                .collect(),
+            class: Class::Hybrid,
+            status,
+            decision: Decision::Exact,
+            reason: None,
+            rank: 0,
+            nullity,
+            linear_residual: 0.0,
+            redundant: Vec::new(),
+            idle: Vec::new(),
+            witness: None,
+            verification: None,
+            relations: Vec::new(),
+            free_directions: Vec::new(),
+            ranges: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_cost_model_by_hand() {
+        let cost = |counterweights, springs, free| {
+            expected_cost(CostFeatures {
+                counterweights,
+                springs,
+                free,
+            })
+        };
+        // 8 + 6·counterweights + 4·springs + 1·free, term by term
+        assert_eq!(cost(0, 0, 0), 8);
+        assert_eq!(cost(1, 0, 0), 14);
+        assert_eq!(cost(0, 1, 0), 12);
+        assert_eq!(cost(0, 0, 1), 9);
+        assert_eq!(cost(2, 1, 5), 8 + 12 + 4 + 5);
+        let hybrid = variant(&["counterweight", "spring", "spring"], 4, Status::Balanced);
+        assert_eq!(
+            CostFeatures::of(&hybrid),
+            CostFeatures {
+                counterweights: 1,
+                springs: 2,
+                free: 4
+            }
+        );
+    }
+
+    #[test]
+    fn only_balanced_variants_are_sharded_and_specs_print_as_parsed() {
+        // costs 8 + 6 = 14 (index 0), 12 (index 2), 8 + 12 = 20 (index 3); index 1 is not
+        // balanced. LPT into 2: 20 → shard 1, 14 → shard 2, 12 → shard 2.
+        let variants = vec![
+            variant(&["counterweight"], 0, Status::Balanced),
+            variant(&["counterweight"], 0, Status::Infeasible),
+            variant(&["spring"], 0, Status::Balanced),
+            variant(&["spring", "spring", "spring"], 0, Status::Balanced),
+        ];
+        let spec = |index| ShardSpec { index, count: 2 };
+        assert_eq!(shard_variants(&variants, spec(1)), vec![3]);
+        assert_eq!(shard_variants(&variants, spec(2)), vec![0, 2]);
+        assert_eq!(spec(2).to_string(), "2/2");
+        assert_eq!("2/2".parse::<ShardSpec>(), Ok(spec(2)));
+    }
 
     #[test]
     fn shard_specs_parse_one_based_and_refuse_the_rest() {

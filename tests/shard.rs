@@ -254,6 +254,21 @@ fn merge_refuses_duplicated_foreign_and_alien_files_naming_them() {
         stderr(&o)
     );
 
+    // a shard numbered outside 1…N (a hand-edited file)
+    let outside = dir.path().join("outside");
+    std::fs::create_dir_all(&outside).unwrap();
+    let mut doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(shards.join("shard-2-of-3.json")).unwrap()).unwrap();
+    doc["shard"] = serde_json::json!(4);
+    std::fs::write(outside.join("shard-4-of-3.json"), doc.to_string()).unwrap();
+    let o = merge(&[&shards, &outside], &out);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("shard index 4 is outside 1…3"),
+        "{}",
+        stderr(&o)
+    );
+
     // not a shard file at all
     let alien = dir.path().join("alien");
     std::fs::create_dir_all(&alien).unwrap();

@@ -269,3 +269,22 @@ pub fn read(path: &Path) -> Result<ShardFile> {
     serde_json::from_value(value)
         .with_context(|| format!("{}: not a valid shard file", path.display()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shard_file_names_are_recognised_and_temporary_files_are_not() {
+        assert!(is_shard_file_name(&file_name(2, 3)));
+        for other in [
+            ".shard-2-of-3.json.tmp-4242",
+            "shard-2-of-3.json.bak",
+            "shard-notes.json",
+            "results.json",
+            "my-shard-1-of-2.json",
+        ] {
+            assert!(!is_shard_file_name(other), "{other} taken for a shard file");
+        }
+    }
+}
