@@ -162,36 +162,25 @@ pub fn shard_variants(variants: &[VariantResult], spec: ShardSpec) -> Vec<usize>
 mod tests {
     use super::*;
     use counterpoise_balance::search::ElementRef;
-    use counterpoise_balance::{Class, Decision, Status};
+    use counterpoise_balance::{Class, Status};
 
     /// A variant of the given element kinds and family dimension; the other fields are not
     /// read by the cost model.
     fn variant(kinds: &[&'static str], nullity: usize, status: Status) -> VariantResult {
+        let elements = kinds
+            .iter()
+            .enumerate()
+            .map(|(entry, &kind)| ElementRef {
+                entry,
+                label: format!("E{entry}"),
+                kind,
+                bodies: Vec::new(),
+            })
+            .collect();
         VariantResult {
-            elements: kinds
-                .iter()
-                .enumerate()
-                .map(|(entry, &kind)| ElementRef {
-                    entry,
-                    label: format!("E{entry}"),
-                    kind,
-                    bodies: Vec::new(),
-                })
-                .collect(),
-            class: Class::Hybrid,
             status,
-            decision: Decision::Exact,
-            reason: None,
-            rank: 0,
             nullity,
-            linear_residual: 0.0,
-            redundant: Vec::new(),
-            idle: Vec::new(),
-            witness: None,
-            verification: None,
-            relations: Vec::new(),
-            free_directions: Vec::new(),
-            ranges: Vec::new(),
+            ..VariantResult::undecided(elements, Class::Hybrid)
         }
     }
 

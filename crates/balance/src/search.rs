@@ -135,6 +135,30 @@ pub struct VariantResult {
     pub ranges: Vec<AdmissibleRange>,
 }
 
+impl VariantResult {
+    /// A variant of these elements before the search has looked at it: `Infeasible` with no
+    /// reason, rank, witness or relations; the search fills in what it finds.
+    pub fn undecided(elements: Vec<ElementRef>, class: Class) -> VariantResult {
+        VariantResult {
+            elements,
+            class,
+            status: Status::Infeasible,
+            decision: Decision::Numeric,
+            reason: None,
+            rank: 0,
+            nullity: 0,
+            linear_residual: 0.0,
+            redundant: Vec::new(),
+            idle: Vec::new(),
+            witness: None,
+            verification: None,
+            relations: Vec::new(),
+            free_directions: Vec::new(),
+            ranges: Vec::new(),
+        }
+    }
+}
+
 /// Settings of a search.
 #[derive(Clone, Copy, Debug)]
 pub struct SearchOptions {
@@ -212,26 +236,11 @@ fn new_result(energy: &MechanismEnergy, entries: &[(usize, &CatalogueEntry)]) ->
         n if n == entries.len() => Class::Springs,
         _ => Class::Hybrid,
     };
-    VariantResult {
-        elements: entries
-            .iter()
-            .map(|(e, entry)| element_ref(energy, *e, entry))
-            .collect(),
-        class,
-        status: Status::Infeasible,
-        decision: Decision::Numeric,
-        reason: None,
-        rank: 0,
-        nullity: 0,
-        linear_residual: 0.0,
-        redundant: Vec::new(),
-        idle: Vec::new(),
-        witness: None,
-        verification: None,
-        relations: Vec::new(),
-        free_directions: Vec::new(),
-        ranges: Vec::new(),
-    }
+    let elements = entries
+        .iter()
+        .map(|(e, entry)| element_ref(energy, *e, entry))
+        .collect();
+    VariantResult::undecided(elements, class)
 }
 
 fn names_and_units(entries: &[(usize, &CatalogueEntry)]) -> (Vec<String>, Vec<&'static str>) {
