@@ -178,6 +178,38 @@ fn run_writes_every_output_and_report_regenerates_them() {
         "header and one row each"
     );
 
+    // The torque charts draw the unbalanced robot and, per class, the variant ranked first in
+    // it: every class present among the feasible variants has its winner in every chart.
+    let winners: std::collections::BTreeSet<u64> = feasible
+        .iter()
+        .filter(|v| v["class_rank"] == 1)
+        .map(|v| v["id"].as_u64().unwrap())
+        .collect();
+    let classes: std::collections::BTreeSet<&str> = feasible
+        .iter()
+        .map(|v| v["class"].as_str().unwrap())
+        .collect();
+    assert_eq!(winners.len(), classes.len(), "one winner per class");
+    let charts = results["torque_charts"].as_array().unwrap();
+    assert!(!charts.is_empty());
+    for chart in charts {
+        let curves = chart["curves"].as_array().unwrap();
+        assert_eq!(curves[0]["label"], "UB");
+        assert!(curves[0]["variant"].is_null());
+        let shown: std::collections::BTreeSet<u64> = curves[1..]
+            .iter()
+            .map(|c| c["variant"].as_u64().unwrap())
+            .collect();
+        assert_eq!(shown, winners, "curves of {}", chart["actuator"]);
+        for c in curves {
+            assert_eq!(
+                c["values"].as_array().unwrap().len(),
+                11,
+                "a value per sample"
+            );
+        }
+    }
+
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains("<svg"));
     assert!(
