@@ -2,6 +2,8 @@
 
 mod common;
 
+use std::collections::BTreeSet;
+
 use common::{assert_success, counterpoise, num, reduced_palletizer, results, stdout, write_case};
 
 /// Eqs. 17–21 written out here from the paper's definition (a second implementation, not the
@@ -31,7 +33,8 @@ fn delta_r(ub: &serde_json::Value, sb: &serde_json::Value) -> f64 {
 fn run_writes_every_output_and_report_regenerates_them() {
     let dir = tempfile::tempdir().unwrap();
     // the palletizer on a 3 × 3 × 3 grid (351 tasks) with 11 samples per task
-    let case = reduced_palletizer(3, 11);
+    let samples = 11;
+    let case = reduced_palletizer(3, samples);
     let case_path = write_case(dir.path(), "palletizer-small.json", &case);
     let out = dir.path().join("out");
 
@@ -180,12 +183,12 @@ fn run_writes_every_output_and_report_regenerates_them() {
 
     // The torque charts draw the unbalanced robot and, per class, the variant ranked first in
     // it: every class present among the feasible variants has its winner in every chart.
-    let winners: std::collections::BTreeSet<u64> = feasible
+    let winners: BTreeSet<u64> = feasible
         .iter()
         .filter(|v| v["class_rank"] == 1)
         .map(|v| v["id"].as_u64().unwrap())
         .collect();
-    let classes: std::collections::BTreeSet<&str> = feasible
+    let classes: BTreeSet<&str> = feasible
         .iter()
         .map(|v| v["class"].as_str().unwrap())
         .collect();
@@ -196,7 +199,7 @@ fn run_writes_every_output_and_report_regenerates_them() {
         let curves = chart["curves"].as_array().unwrap();
         assert_eq!(curves[0]["label"], "UB");
         assert!(curves[0]["variant"].is_null());
-        let shown: std::collections::BTreeSet<u64> = curves[1..]
+        let shown: BTreeSet<u64> = curves[1..]
             .iter()
             .map(|c| c["variant"].as_u64().unwrap())
             .collect();
@@ -204,7 +207,7 @@ fn run_writes_every_output_and_report_regenerates_them() {
         for c in curves {
             assert_eq!(
                 c["values"].as_array().unwrap().len(),
-                11,
+                samples,
                 "a value per sample"
             );
         }
