@@ -9,19 +9,12 @@
 
 mod common;
 
-use counterpoise_balance::Status;
 use counterpoise_optimise::{Context, OptimiseOptions, optimise_all_timed};
 
 #[test]
 fn stage_times_lie_within_the_call_and_passes_match_the_iterations() {
     let model = common::model(&common::case_json("two_link.json"));
-    let report = common::balance_search(&model);
-    let balanced: Vec<_> = report
-        .variants
-        .iter()
-        .filter(|v| v.status == Status::Balanced)
-        .cloned()
-        .collect();
+    let balanced = common::balanced_variants(&model);
     assert!(
         !balanced.is_empty(),
         "the two-link arm has balanced variants"

@@ -36,6 +36,15 @@ pub fn balance_search(model: &Model) -> SearchReport {
     )
 }
 
+/// The balanced variants of the case's balance search.
+pub fn balanced_variants(model: &Model) -> Vec<counterpoise_balance::VariantResult> {
+    balance_search(model)
+        .variants
+        .into_iter()
+        .filter(|v| v.status == Status::Balanced)
+        .collect()
+}
+
 /// Runs the search and optimises the balanced variants whose label sets are in `wanted`
 /// (all balanced ones when empty).
 pub fn optimise(
