@@ -52,11 +52,8 @@ pub fn optimise(
     wanted: &[&[&str]],
     options: &OptimiseOptions,
 ) -> (Context, Vec<OptimisedVariant>) {
-    let report = balance_search(model);
-    let chosen: Vec<_> = report
-        .variants
-        .iter()
-        .filter(|v| v.status == Status::Balanced)
+    let chosen: Vec<_> = balanced_variants(model)
+        .into_iter()
         .filter(|v| {
             wanted.is_empty()
                 || wanted.iter().any(|w| {
@@ -64,7 +61,6 @@ pub fn optimise(
                         && w.iter().all(|l| v.elements.iter().any(|e| &e.label == l))
                 })
         })
-        .cloned()
         .collect();
     let ctx = Context::new(model, None).unwrap();
     let results = optimise_all(&ctx, &chosen, options);
