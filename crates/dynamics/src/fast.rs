@@ -103,7 +103,7 @@ struct InertiaGroups {
     /// Every column, in order.
     all: ColumnBatch,
     /// Per column, its group.
-    group: Vec<usize>,
+    group: Vec<u32>,
     /// The groups' spring-free representatives (one column per group).
     rep_params: ParameterSet,
     rep_batch: ColumnBatch,
@@ -114,7 +114,7 @@ impl InertiaGroups {
         let inertial = crate::params::BODY_PARAMS * params.bodies;
         let mut index: HashMap<Vec<u64>, usize> = HashMap::new();
         let mut rep_params = ParameterSet::empty(params.bodies, params.springs.clone());
-        let group: Vec<usize> = (0..params.len())
+        let group: Vec<u32> = (0..params.len())
             .map(|p| {
                 let body_part = &params.column(p)[..inertial];
                 let key = body_part.iter().map(|x| x.to_bits()).collect();
@@ -125,7 +125,7 @@ impl InertiaGroups {
                         .push_column(&column)
                         .expect("a column of the set's own shape");
                     rep_params.len() - 1
-                })
+                }) as u32
             })
             .collect();
         let all: Vec<usize> = (0..params.len()).collect();
@@ -142,9 +142,7 @@ impl InertiaGroups {
     /// rep_zero[g])` with `g` the column's group, `zero` the columns' values at `Δ = 0` and
     /// `rep_zero` the representatives'.
     fn expand(&self, dst: &mut [f64], rep: &[f64], zero: &[f64], rep_zero: &[f64]) {
-        for ((d, &g), &z) in dst.iter_mut().zip(&self.group).zip(zero) {
-            *d = rep[g] + (z - rep_zero[g]);
-        }
+        expand_from_groups(&self.group, dst, rep, zero, rep_zero);
     }
 }
 
@@ -403,7 +401,7 @@ pub(crate) fn evaluate_cyclic(
 crate::simd::multiversion! {
 /// Statistics of every `(reversed, Δ)` task of one sub-task. Samples run in the outer loop
 /// so that a sample's coefficients are read from cache once for all the tasks; within a task
-/// every step is a contiguous sweep over `[actuator or joint][column]`.
+/// every step is a contiguous sweep over the columns of one actuator or joint.
 fn task_stats(
     coefficients: &[f64],
     stride: usize,
@@ -424,48 +422,66 @@ fn task_stats(
     let reaction_peak = zeroed(&mut scratch.reaction_peak, nt * rq);
     let tau = zeroed(&mut scratch.tau, tq);
     let abs_sum = zeroed(&mut scratch.abs_sum, cols);
-    for k in 0..ns {
-        for (t, &(rev, delta)) in tasks.iter().enumerate() {
-            let dd = if rev { -delta } else { delta };
-            let d2 = dd * dd;
-            let kk = if rev { ns - 1 - k } else { k };
-            let base = &coefficients[kk * stride..(kk + 1) * stride];
-            let (t0, rest) = base.split_at(tq);
-            let (t1, rest) = rest.split_at(tq);
-            let (t2, rest) = rest.split_at(tq);
-            for (i, v) in tau.iter_mut().enumerate() {
-                *v = t0[i] + dd * t1[i] + d2 * t2[i];
-            }
-            let ss = &mut sum_sq[t * tq..(t + 1) * tq];
-            let pk = &mut peak[t * tq..(t + 1) * tq];
-            for i in 0..tq {
-                ss[i] += tau[i] * tau[i];
-                let x = tau[i].abs();
-                if x > pk[i] {
-                    pk[i] = x;
+    // (Blocking the columns so that a block's sums stay in L2 was measured slower: the
+    // coefficients are then read in short strided runs.)
+    {
+        let (b0, b1) = (0, cols);
+        for k in 0..ns {
+            for (t, &(rev, delta)) in tasks.iter().enumerate() {
+                let dd = if rev { -delta } else { delta };
+                let d2 = dd * dd;
+                let kk = if rev { ns - 1 - k } else { k };
+                let base = &coefficients[kk * stride..(kk + 1) * stride];
+                let (t0, rest) = base.split_at(tq);
+                let (t1, rest) = rest.split_at(tq);
+                let (t2, rest) = rest.split_at(tq);
+                let abs_sum = &mut abs_sum[b0..b1];
+                abs_sum.fill(0.0);
+                for a in 0..na {
+                    let r = a * cols + b0..a * cols + b1;
+                    let tau = &mut tau[r.clone()];
+                    let (t0, t1, t2) = (&t0[r.clone()], &t1[r.clone()], &t2[r.clone()]);
+                    let ss = &mut sum_sq[t * tq..(t + 1) * tq][r.clone()];
+                    let pk = &mut peak[t * tq..(t + 1) * tq][r];
+                    for i in 0..tau.len() {
+                        tau[i] = t0[i] + dd * t1[i] + d2 * t2[i];
+                    }
+                    for i in 0..tau.len() {
+                        ss[i] += tau[i] * tau[i];
+                        let x = tau[i].abs();
+                        if x > pk[i] {
+                            pk[i] = x;
+                        }
+                    }
+                    for (s, x) in abs_sum.iter_mut().zip(tau.iter()) {
+                        *s += x.abs();
+                    }
                 }
-            }
-            abs_sum.fill(0.0);
-            for row in tau.chunks_exact(cols) {
-                for (s, x) in abs_sum.iter_mut().zip(row) {
-                    *s += x.abs();
+                for (m, &s) in total_peak[t * cols + b0..t * cols + b1]
+                    .iter_mut()
+                    .zip(abs_sum.iter())
+                {
+                    if s > *m {
+                        *m = s;
+                    }
                 }
-            }
-            for (m, &s) in total_peak[t * cols..(t + 1) * cols].iter_mut().zip(abs_sum.iter()) {
-                if s > *m {
-                    *m = s;
-                }
-            }
-            if nj > 0 {
-                let (c0, rest) = rest.split_at(rq);
-                let (c1, rest) = rest.split_at(rq);
-                let (c2, rest) = rest.split_at(rq);
-                let (c3, c4) = rest.split_at(rq);
-                let pk = &mut reaction_peak[t * rq..(t + 1) * rq];
-                for i in 0..rq {
-                    let v = (((c4[i] * dd + c3[i]) * dd + c2[i]) * dd + c1[i]) * dd + c0[i];
-                    if v > pk[i] {
-                        pk[i] = v;
+                if nj > 0 {
+                    let (c0, rest) = rest.split_at(rq);
+                    let (c1, rest) = rest.split_at(rq);
+                    let (c2, rest) = rest.split_at(rq);
+                    let (c3, c4) = rest.split_at(rq);
+                    let pk = &mut reaction_peak[t * rq..(t + 1) * rq];
+                    for row in 0..2 * nj {
+                        let r = row * cols + b0..row * cols + b1;
+                        let pk = &mut pk[r.clone()];
+                        let (c0, c1, c2) = (&c0[r.clone()], &c1[r.clone()], &c2[r.clone()]);
+                        let (c3, c4) = (&c3[r.clone()], &c4[r]);
+                        for i in 0..pk.len() {
+                            let v = (((c4[i] * dd + c3[i]) * dd + c2[i]) * dd + c1[i]) * dd + c0[i];
+                            if v > pk[i] {
+                                pk[i] = v;
+                            }
+                        }
                     }
                 }
             }
@@ -524,7 +540,6 @@ fn sub_task(
         0
     };
     let rows = 6 * l;
-    let m = 3 * cols;
     let tq = n * cols;
     let rq = 2 * nj * cols;
     let nreps = groups.rep_batch.len();
@@ -542,7 +557,7 @@ fn sub_task(
     if with_reactions {
         work.b.resize(rows * solved, 0.0);
         work.out.resize(6 * nj * solved, 0.0);
-        work.reactions.resize(6 * nj * m, 0.0);
+        work.reactions.resize(6 * nj * 2 * cols, 0.0);
     }
     for k in 0..ns {
         let t = sample_time(k, ns, duration);
@@ -563,6 +578,7 @@ fn sub_task(
         if with_reactions {
             ev.reactions
                 .prepare(mech, &pose, &work.kin, &lu, &mut work.reactions_work);
+            ev.reactions.prepare_operator(&mut work.reactions_work);
         }
         for (si, d) in [0.0, 1.0, -1.0].into_iter().enumerate() {
             let mut qd = ud;
@@ -599,12 +615,20 @@ fn sub_task(
                 } else {
                     &params.springs
                 };
-                work.wb.resize(rows * nc, 0.0);
+                // The wrenches go straight into the batch's block of the right-hand sides
+                // (rows `solved` apart), or into a buffer of their own without reactions.
+                let (w, row_stride) = if with_reactions {
+                    (&mut work.b[first..], solved)
+                } else {
+                    work.wb.resize(rows * nc, 0.0);
+                    (&mut work.wb[..], nc)
+                };
                 work.qb.resize(n * nc, 0.0);
-                required_wrenches_batch(mech, &pose, &work.regressors, slots, batch, &mut work.wb);
+                required_wrenches_batch(mech, &pose, &work.regressors, slots, batch, w, row_stride);
                 actuator_forces_batch(
                     &work.kin,
-                    &work.wb,
+                    w,
+                    row_stride,
                     nc,
                     n,
                     &lu,
@@ -629,26 +653,16 @@ fn sub_task(
                             &work.reactions_work,
                             &work.kin,
                             &qu,
-                            &mut work.wb[c..],
-                            nc,
+                            &mut w[c..],
+                            row_stride,
                         );
-                    }
-                }
-                if with_reactions {
-                    for r in 0..rows {
-                        work.b[r * solved + first..r * solved + first + nc]
-                            .copy_from_slice(&work.wb[r * nc..(r + 1) * nc]);
                     }
                 }
             }
         }
         if with_reactions {
-            ev.reactions.solve_prepared(
-                &mut work.reactions_work,
-                &mut work.b,
-                solved,
-                &mut work.out,
-            );
+            ev.reactions
+                .apply_operator(&work.reactions_work, &work.b, solved, &mut work.out);
         }
         work.scratch.pose = pose;
         // Every column at Δ = ±1 from its representative: X_p(±1) = X_r(±1) + X_p(0) − X_r(0).
@@ -665,15 +679,15 @@ fn sub_task(
             }
         }
         if with_reactions {
+            // X_p(±1) per joint wrench row; X_p(0) stays in `work.out`
             for row in 0..6 * nj {
                 let src = &work.out[row * solved..(row + 1) * solved];
-                let dst = &mut work.reactions[row * m..(row + 1) * m];
+                let dst = &mut work.reactions[row * 2 * cols..(row + 1) * 2 * cols];
                 let zero = &src[..cols];
                 let reps = |d: usize| &src[cols + d * nreps..cols + (d + 1) * nreps];
-                dst[..cols].copy_from_slice(zero);
                 for si in 0..2 {
                     groups.expand(
-                        &mut dst[(si + 1) * cols..(si + 2) * cols],
+                        &mut dst[si * cols..(si + 1) * cols],
                         reps(si + 1),
                         zero,
                         reps(0),
@@ -681,13 +695,14 @@ fn sub_task(
                 }
             }
         }
-        let reactions = &work.reactions[..if with_reactions { 6 * nj * m } else { 0 }];
-        let non_finite = work
-            .torques
-            .iter()
-            .chain(reactions)
-            .fold(false, |bad, x| bad | !x.is_finite());
-        if non_finite {
+        let mut finite = all_finite(&work.torques);
+        if with_reactions {
+            for row in 0..6 * nj {
+                finite &= all_finite(&work.out[row * solved..row * solved + cols]);
+            }
+            finite &= all_finite(&work.reactions[..6 * nj * 2 * cols]);
+        }
+        if !finite {
             return Err((k, FailureReason::NonFinite));
         }
         // X0 = X(0), X1 = (X(1) − X(−1))/2, X2 = (X(1) + X(−1))/2 − X(0), per column; then
@@ -698,11 +713,7 @@ fn sub_task(
         let (tc1, tc2) = rest.split_at_mut(tq);
         let (x0, rest) = work.torques.split_at(tq);
         let (xp, xm) = rest.split_at(tq);
-        for i in 0..tq {
-            tc0[i] = x0[i];
-            tc1[i] = 0.5 * (xp[i] - xm[i]);
-            tc2[i] = 0.5 * (xp[i] + xm[i]) - x0[i];
-        }
+        quadratic_coefficients([x0, xp, xm], [tc0, tc1, tc2]);
         if with_reactions {
             let (q0, rest) = reaction_coefs.split_at_mut(rq);
             let (q1, rest) = rest.split_at_mut(rq);
@@ -711,48 +722,104 @@ fn sub_task(
             for part in 0..2 {
                 for j in 0..nj {
                     let slot = (part * nj + j) * cols..(part * nj + j + 1) * cols;
-                    let (q0, q1, q2) = (
-                        &mut q0[slot.clone()],
-                        &mut q1[slot.clone()],
-                        &mut q2[slot.clone()],
-                    );
-                    let (q3, q4) = (&mut q3[slot.clone()], &mut q4[slot]);
                     // the three components' rows at Δ = 0, +1, −1
                     let component = |r: usize| {
                         let row = 6 * j + 3 * part + r;
-                        let row = &reactions[row * m..(row + 1) * m];
-                        let (x0, rest) = row.split_at(cols);
-                        let (xp, xm) = rest.split_at(cols);
-                        (x0, xp, xm)
+                        let x0 = &work.out[row * solved..row * solved + cols];
+                        let pm = &work.reactions[row * 2 * cols..(row + 1) * 2 * cols];
+                        let (xp, xm) = pm.split_at(cols);
+                        [x0, xp, xm]
                     };
-                    let rows = [component(0), component(1), component(2)];
-                    for p in 0..cols {
-                        let mut sums = [0.0; 5];
-                        for (r, (x0, xp, xm)) in rows.iter().enumerate() {
-                            let c0 = x0[p];
-                            let c1 = 0.5 * (xp[p] - xm[p]);
-                            let c2 = 0.5 * (xp[p] + xm[p]) - c0;
-                            let terms = [
-                                c0 * c0,
-                                2.0 * c0 * c1,
-                                c1 * c1 + 2.0 * c0 * c2,
-                                2.0 * c1 * c2,
-                                c2 * c2,
-                            ];
-                            for (s, t) in sums.iter_mut().zip(terms) {
-                                // the first component is assigned, not added to zero
-                                *s = if r == 0 { t } else { *s + t };
-                            }
-                        }
-                        q0[p] = sums[0];
-                        q1[p] = sums[1];
-                        q2[p] = sums[2];
-                        q3[p] = sums[3];
-                        q4[p] = sums[4];
-                    }
+                    squared_norm_quartic(
+                        [component(0), component(1), component(2)],
+                        [
+                            &mut q0[slot.clone()],
+                            &mut q1[slot.clone()],
+                            &mut q2[slot.clone()],
+                            &mut q3[slot.clone()],
+                            &mut q4[slot],
+                        ],
+                    );
                 }
             }
         }
     }
     Ok(())
+}
+
+crate::simd::multiversion! {
+/// Whether every value is finite (a branch-free reduction the compiler vectorises).
+fn all_finite(xs: &[f64]) -> bool {
+    !xs.iter().fold(false, |bad, x| bad | !x.is_finite())
+}
+}
+
+crate::simd::multiversion! {
+/// `dst[p] = rep[g] + (zero[p] − rep_zero[g])` with `g = group[p]` (see
+/// [`InertiaGroups::expand`]).
+fn expand_from_groups(group: &[u32], dst: &mut [f64], rep: &[f64], zero: &[f64], rep_zero: &[f64]) {
+    let n = rep.len().min(rep_zero.len());
+    assert!(group.iter().all(|&g| (g as usize) < n), "group index out of range");
+    for ((d, &g), &z) in dst.iter_mut().zip(group).zip(zero) {
+        let g = g as usize;
+        // SAFETY: every group index is below the length of `rep` and `rep_zero` (asserted
+        // above); unchecked loads let the compiler gather them in vectors.
+        let (r, r0) = unsafe { (*rep.get_unchecked(g), *rep_zero.get_unchecked(g)) };
+        *d = r + (z - r0);
+    }
+}
+}
+
+crate::simd::multiversion! {
+/// The coefficients of `X(Δ) = X₀ + Δ X₁ + Δ² X₂` from its values at `Δ = 0, 1, −1`:
+/// `X₀ = X(0)`, `X₁ = (X(1) − X(−1))/2`, `X₂ = (X(1) + X(−1))/2 − X(0)`.
+fn quadratic_coefficients(x: [&[f64]; 3], c: [&mut [f64]; 3]) {
+    let [x0, xp, xm] = x;
+    let [c0, c1, c2] = c;
+    let n = x0.len();
+    let (xp, xm, c0, c1, c2) = (&xp[..n], &xm[..n], &mut c0[..n], &mut c1[..n], &mut c2[..n]);
+    for i in 0..n {
+        c0[i] = x0[i];
+        c1[i] = 0.5 * (xp[i] - xm[i]);
+        c2[i] = 0.5 * (xp[i] + xm[i]) - x0[i];
+    }
+}
+}
+
+crate::simd::multiversion! {
+/// `|X(Δ)|²` of a three-component vector whose components are quadratics in `Δ` (each given
+/// by its values at `Δ = 0, 1, −1`, see [`quadratic_coefficients`]), as the five coefficients
+/// of a quartic, per column. Components are summed in order, the first one assigned.
+fn squared_norm_quartic(components: [[&[f64]; 3]; 3], q: [&mut [f64]; 5]) {
+    let [q0, q1, q2, q3, q4] = q;
+    let n = q0.len();
+    let (q1, q2, q3, q4) = (&mut q1[..n], &mut q2[..n], &mut q3[..n], &mut q4[..n]);
+    let [[a0, ap, am], [b0, bp, bm], [d0, dp, dm]] = components;
+    let (a0, ap, am) = (&a0[..n], &ap[..n], &am[..n]);
+    let (b0, bp, bm) = (&b0[..n], &bp[..n], &bm[..n]);
+    let (d0, dp, dm) = (&d0[..n], &dp[..n], &dm[..n]);
+    #[inline(always)]
+    fn terms(x0: f64, xp: f64, xm: f64) -> [f64; 5] {
+        let c0 = x0;
+        let c1 = 0.5 * (xp - xm);
+        let c2 = 0.5 * (xp + xm) - c0;
+        [
+            c0 * c0,
+            2.0 * c0 * c1,
+            c1 * c1 + 2.0 * c0 * c2,
+            2.0 * c1 * c2,
+            c2 * c2,
+        ]
+    }
+    for p in 0..n {
+        let ta = terms(a0[p], ap[p], am[p]);
+        let tb = terms(b0[p], bp[p], bm[p]);
+        let td = terms(d0[p], dp[p], dm[p]);
+        q0[p] = ta[0] + tb[0] + td[0];
+        q1[p] = ta[1] + tb[1] + td[1];
+        q2[p] = ta[2] + tb[2] + td[2];
+        q3[p] = ta[3] + tb[3] + td[3];
+        q4[p] = ta[4] + tb[4] + td[4];
+    }
+}
 }

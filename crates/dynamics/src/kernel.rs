@@ -256,7 +256,8 @@ impl ColumnBatch {
 
 crate::simd::multiversion! {
 /// [`required_wrenches_with`] for every column of `batch` into `w` (`6L` rows of
-/// `batch.len()` values, row-major): the same expressions and summation order per column.
+/// `batch.len()` values, row-major, rows `row_stride` apart — a block of a wider right-hand
+/// side): the same expressions and summation order per column.
 pub fn required_wrenches_batch(
     mech: &Mechanism,
     pose: &[f64],
@@ -264,6 +265,7 @@ pub fn required_wrenches_batch(
     slots: &[SpringSlot],
     batch: &ColumnBatch,
     w: &mut [f64],
+    row_stride: usize,
 ) {
     let nc = batch.len();
     for (i, reg) in regressors.iter().enumerate() {
@@ -275,7 +277,8 @@ pub fn required_wrenches_batch(
             for (c, v) in coefficients.iter().zip(base) {
                 value += c * v;
             }
-            w[(6 * i + r) * nc..(6 * i + r + 1) * nc].fill(value);
+            let row = (6 * i + r) * row_stride;
+            w[row..row + nc].fill(value);
         }
         let touched = &batch.touched[i];
         let values = &batch.touched_params[i];
@@ -295,7 +298,7 @@ pub fn required_wrenches_batch(
             }
             for (l, &p) in touched[k0..].iter().take(LANES).enumerate() {
                 for (r, a) in acc.iter().enumerate() {
-                    w[(6 * i + r) * nc + p] = a[l];
+                    w[(6 * i + r) * row_stride + p] = a[l];
                 }
             }
         }
@@ -305,18 +308,21 @@ pub fn required_wrenches_batch(
     for (p, springs) in batch.springs.iter().enumerate() {
         for (s, x) in springs {
             let frame = frames[*s].get_or_insert_with(|| SpringFrame::new(mech, pose, &slots[*s]));
-            subtract_spring_with(&slots[*s], frame.wrenches(x), &mut w[p..], nc);
+            subtract_spring_with(&slots[*s], frame.wrenches(x), &mut w[p..], row_stride);
         }
     }
 }
 }
 
 crate::simd::multiversion! {
-/// [`actuator_forces`] for `nc` columns of wrenches `w` (`6L × nc`, row-major) into `qu`
-/// (`n × nc`, row-major; `z` scratch). Same summation order per column.
+/// [`actuator_forces`] for `nc` columns of wrenches `w` (`6L × nc`, row-major, rows
+/// `row_stride` apart) into `qu` (`n × nc`, row-major; `z` scratch). Same summation order per
+/// column.
+#[allow(clippy::too_many_arguments)]
 pub fn actuator_forces_batch(
     kin: &[BodyKin],
     w: &[f64],
+    row_stride: usize,
     nc: usize,
     n: usize,
     lu: &SmallLu,
@@ -325,7 +331,7 @@ pub fn actuator_forces_batch(
 ) {
     qu[..n * nc].fill(0.0);
     for (i, k) in kin.iter().enumerate() {
-        let row = |r: usize| &w[(6 * i + r) * nc..(6 * i + r + 1) * nc];
+        let row = |r: usize| &w[(6 * i + r) * row_stride..(6 * i + r) * row_stride + nc];
         let (f0, f1, f2) = (row(0), row(1), row(2));
         let (m0, m1, m2) = (row(3), row(4), row(5));
         for j in 0..n {

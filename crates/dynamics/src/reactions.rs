@@ -556,9 +556,9 @@ impl ReactionSolver {
     ) {
         let rows = work.rows;
         let k = work.k;
-        work.y.clear();
-        work.y.resize(k * m, 0.0);
         if let Some(pinv) = &work.pinv {
+            work.y.clear();
+            work.y.resize(k * m, 0.0);
             for c in 0..k {
                 for r in 0..rows {
                     let x = pinv[(c, r)];
@@ -570,6 +570,11 @@ impl ReactionSolver {
                 }
             }
         } else {
+            // every value is written by the substitution (no zero fill: at thousands of
+            // right-hand sides per sample the fill costs as much memory traffic as the solve)
+            if work.y.len() < k * m {
+                work.y.resize(k * m, 0.0);
+            }
             let factor = Factor {
                 rows,
                 l: &work.l,
@@ -579,7 +584,12 @@ impl ReactionSolver {
             };
             chunk_solve(factor, &work.a, &work.nz, k, b, m, &mut work.y, &mut work.z);
         }
-        out[..6 * self.joints.len() * m].fill(0.0);
+        // Each output row is the sum of its basis vectors' contributions in a fixed order. The
+        // first contribution is written as `0.0 + e·λ` — the bits of adding it to a zeroed
+        // row — so rows need no zero fill; rows without a contribution are zeroed at the end.
+        let out_rows = 6 * self.joints.len();
+        work.written.clear();
+        work.written.resize(out_rows, false);
         for (jn, (j, f)) in self.joints.iter().zip(&work.frames).enumerate() {
             let bases = f
                 .forces()
@@ -590,14 +600,57 @@ impl ReactionSolver {
                 let lam = &work.y[col * m..(col + 1) * m];
                 for r in 0..3 {
                     if e[r] != 0.0 {
-                        let o = &mut out[(6 * jn + base + r) * m..(6 * jn + base + r + 1) * m];
-                        for p in 0..m {
-                            o[p] += e[r] * lam[p];
+                        let row = 6 * jn + base + r;
+                        let o = &mut out[row * m..(row + 1) * m];
+                        let x = e[r];
+                        if work.written[row] {
+                            for (o, &l) in o.iter_mut().zip(lam) {
+                                *o += x * l;
+                            }
+                        } else {
+                            for (o, &l) in o.iter_mut().zip(lam) {
+                                *o = 0.0 + x * l;
+                            }
+                            work.written[row] = true;
                         }
                     }
                 }
             }
         }
+        for (row, &w) in work.written.iter().enumerate() {
+            if !w {
+                out[row * m..(row + 1) * m].fill(0.0);
+            }
+        }
+    }
+
+    /// The reaction operator of a prepared sample: the `6J × 6L` matrix `O` (row-major) that
+    /// maps a right-hand side to the joint wrench rows of [`Self::solve_prepared`], obtained
+    /// by solving for the `6L` unit right-hand sides. With thousands of right-hand sides per
+    /// sample (a grid batch), applying `O` by [`Self::apply_operator`] costs about a third of
+    /// the substitutions per right-hand side.
+    pub fn prepare_operator(&self, work: &mut ReactionWork) {
+        let rows = work.rows;
+        let mut unit = std::mem::take(&mut work.unit);
+        unit.clear();
+        unit.resize(rows * rows, 0.0);
+        for i in 0..rows {
+            unit[i * rows + i] = 1.0;
+        }
+        let mut op = std::mem::take(&mut work.op);
+        op.resize(6 * self.joints.len() * rows, 0.0);
+        self.solve_prepared(work, &mut unit, rows, &mut op);
+        work.op = op;
+        work.unit = unit;
+    }
+
+    /// `out = O b` for `m` right-hand sides `b` (`6L × m`, row-major) with the operator of
+    /// [`Self::prepare_operator`]; `out` as in [`Self::solve_prepared`]. Each value is the
+    /// same fused multiply-add chain whatever `m` and the column's position, so a column's
+    /// bits do not depend on its batch.
+    pub fn apply_operator(&self, work: &ReactionWork, b: &[f64], m: usize, out: &mut [f64]) {
+        let nr = 6 * self.joints.len();
+        apply_operator_kernel(&work.op, nr, work.rows, b, m, out);
     }
 }
 
@@ -625,6 +678,12 @@ pub struct ReactionWork {
     pinv: Option<DMatrix<f64>>,
     y: Vec<f64>,
     z: SolveScratch,
+    /// Output rows of [`ReactionSolver::solve_prepared`] that have received a contribution.
+    written: Vec<bool>,
+    /// The reaction operator (see [`ReactionSolver::prepare_operator`]), `6J × 6L` row-major.
+    op: Vec<f64>,
+    /// The unit right-hand sides the operator is solved for.
+    unit: Vec<f64>,
 }
 
 crate::simd::multiversion! {
@@ -922,4 +981,80 @@ fn mobility_basis(kin: &[BodyKin], n: usize) -> DMatrix<f64> {
         return DMatrix::zeros(rows, 0);
     }
     DMatrix::from_columns(&cols)
+}
+
+crate::simd::multiversion! {
+/// `out = op · b` (`op` row-major `nr × nk`, `b` row-major `nk × m`, `out` row-major
+/// `nr × m`). Every value is `s = 0; s = fma(op[r][k], b[k][p], s)` for `k = 0, 1, …` —
+/// one exactly rounded chain, the same in every register tile shape and in every
+/// instruction-set version, so a value does not depend on `m` or on the column's position.
+fn apply_operator_kernel(op: &[f64], nr: usize, nk: usize, b: &[f64], m: usize, out: &mut [f64]) {
+    // Wide tiles (3 rows × 64 columns: 24 vector accumulators, each broadcast of `op` feeding
+    // eight fused multiply-adds), then one-vector tiles, then single columns.
+    let mut c0 = 0;
+    while c0 + 8 * LANE <= m {
+        operator_rows::<3, { 8 * LANE }>(op, nr, nk, b, m, out, c0);
+        c0 += 8 * LANE;
+    }
+    while c0 + LANE <= m {
+        operator_rows::<6, LANE>(op, nr, nk, b, m, out, c0);
+        c0 += LANE;
+    }
+    while c0 < m {
+        operator_rows::<1, 1>(op, nr, nk, b, m, out, c0);
+        c0 += 1;
+    }
+}
+}
+
+/// Columns `c0 .. c0 + W` of every output row of [`apply_operator_kernel`], `R` rows at a
+/// time (then one at a time).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn operator_rows<const R: usize, const W: usize>(
+    op: &[f64],
+    nr: usize,
+    nk: usize,
+    b: &[f64],
+    m: usize,
+    out: &mut [f64],
+    c0: usize,
+) {
+    let mut r0 = 0;
+    while r0 + R <= nr {
+        operator_tile::<R, W>(op, nk, b, m, out, r0, c0);
+        r0 += R;
+    }
+    while r0 < nr {
+        operator_tile::<1, W>(op, nk, b, m, out, r0, c0);
+        r0 += 1;
+    }
+}
+
+/// One `R × W` register tile of [`apply_operator_kernel`].
+#[inline(always)]
+fn operator_tile<const R: usize, const W: usize>(
+    op: &[f64],
+    nk: usize,
+    b: &[f64],
+    m: usize,
+    out: &mut [f64],
+    r0: usize,
+    c0: usize,
+) {
+    let mut acc = [[0.0f64; W]; R];
+    for k in 0..nk {
+        let bk: &[f64; W] = b[k * m + c0..k * m + c0 + W]
+            .try_into()
+            .expect("a whole tile");
+        for (r, a) in acc.iter_mut().enumerate() {
+            let o = op[(r0 + r) * nk + k];
+            for l in 0..W {
+                a[l] = o.mul_add(bk[l], a[l]);
+            }
+        }
+    }
+    for (r, a) in acc.iter().enumerate() {
+        out[(r0 + r) * m + c0..(r0 + r) * m + c0 + W].copy_from_slice(a);
+    }
 }

@@ -393,3 +393,56 @@ fn balanced_witness_has_no_static_torque() {
         }
     }
 }
+
+/// The reaction operator of the grid evaluation (`O`, solved once per sample for the unit
+/// right-hand sides) against the substitution solve of every right-hand side: the same joint
+/// wrenches to rounding; and applied to one column alone, the same bits as within a batch of
+/// 37 (the tiles of the product differ with the batch width, the value may not).
+#[test]
+fn reaction_operator_matches_the_substitution_solve() {
+    use counterpoise_dynamics::lu::SmallLu;
+    use counterpoise_dynamics::mechanism::Scratch;
+    use counterpoise_dynamics::reactions::ReactionWork;
+    let model = case("palletizer");
+    let ev = Evaluator::new(&model).unwrap();
+    let mech = &ev.mech;
+    let mut rng = SplitMix64::new(41);
+    let rows = 6 * mech.body_count;
+    let out_rows = 6 * ev.reactions.joint_count();
+    for _ in 0..3 {
+        let (q, _, _) = random_state(&model, &mut rng);
+        let mut scratch = Scratch::default();
+        mech.eval_poses(&q, &mut scratch);
+        let pose = scratch.pose.clone();
+        let kin: Vec<_> = (0..mech.body_count)
+            .map(|b| mech.body_frame(&pose, b))
+            .collect();
+        let mut u = vec![0.0; 12];
+        let mut g = vec![0.0; 144];
+        mech.actuator_map(&q, &mut scratch, &mut u, &mut g);
+        let lu = SmallLu::new(&g, mech.n);
+        let mut work = ReactionWork::default();
+        ev.reactions.prepare(mech, &pose, &kin, &lu, &mut work);
+        let m = 37;
+        let b: Vec<f64> = (0..rows * m).map(|_| rng.uniform(-100.0, 100.0)).collect();
+        let mut solved = vec![0.0; out_rows * m];
+        ev.reactions
+            .solve_prepared(&mut work, &mut b.clone(), m, &mut solved);
+        ev.reactions.prepare_operator(&mut work);
+        let mut applied = vec![0.0; out_rows * m];
+        ev.reactions.apply_operator(&work, &b, m, &mut applied);
+        let scale = solved.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        assert!(scale > 1.0);
+        for (x, y) in solved.iter().zip(&applied) {
+            assert!((x - y).abs() <= 1e-12 * scale, "{x} vs {y}");
+        }
+        for p in [0, 16, 36] {
+            let column: Vec<f64> = (0..rows).map(|r| b[r * m + p]).collect();
+            let mut alone = vec![0.0; out_rows];
+            ev.reactions.apply_operator(&work, &column, 1, &mut alone);
+            for r in 0..out_rows {
+                assert_eq!(alone[r].to_bits(), applied[r * m + p].to_bits());
+            }
+        }
+    }
+}
