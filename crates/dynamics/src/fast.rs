@@ -25,6 +25,14 @@
 //! Spring-only variants share the unbalanced robot's inertia, so a batch of them costs about
 //! one third of the reaction solves. The representative depends on the column alone, never on
 //! the rest of the batch, so a column's values are the same bits in any batch.
+//!
+//! Joint reactions are linear in the right-hand side of the reaction equations: per sample the
+//! reaction operator `O` (see [`crate::reactions::ReactionSolver::prepare_operator`]) maps
+//! every column's right-hand side at `Δ = 0` to its reactions, and each group's changes
+//! `b_r(±1) − b_r(0)` to the changes `X_r(±1) − X_r(0)` — two products per group instead of
+//! three. A column's reaction components are then `x₀ + Δ (D₊ − D₋)/2 + Δ² (D₊ + D₋)/2` with
+//! `D±` its group's changes: at a sample at rest (`D± = 0`) every `Δ` gives the same bits,
+//! so moves that share a static end pose tie exactly.
 
 use std::collections::HashMap;
 
@@ -61,8 +69,6 @@ struct Work {
     torques: Vec<f64>,
     /// Motor torques of the group representatives at `Δ = ±1`: `[Δ][actuator][group]`.
     rep_torques: Vec<f64>,
-    /// Joint wrench components at `Δ ∈ {0, 1, −1}`: `[joint row][Δ][column]`.
-    reactions: Vec<f64>,
     /// Coefficients of the current sub-task, per sample (`stride` values): the motor torques
     /// as quadratics in `Δ` — three arrays `[actuator][column]` — then, with reactions,
     /// `|F_j|²` and `|M_j|²` as quartics — five arrays `[force/moment][joint][column]`.
@@ -477,7 +483,11 @@ fn task_stats(
                         let (c0, c1, c2) = (&c0[r.clone()], &c1[r.clone()], &c2[r.clone()]);
                         let (c3, c4) = (&c3[r.clone()], &c4[r]);
                         for i in 0..pk.len() {
-                            let v = (((c4[i] * dd + c3[i]) * dd + c2[i]) * dd + c1[i]) * dd + c0[i];
+                            let v = c4[i]
+                                .mul_add(dd, c3[i])
+                                .mul_add(dd, c2[i])
+                                .mul_add(dd, c1[i])
+                                .mul_add(dd, c0[i]);
                             if v > pk[i] {
                                 pk[i] = v;
                             }
@@ -557,7 +567,6 @@ fn sub_task(
     if with_reactions {
         work.b.resize(rows * solved, 0.0);
         work.out.resize(6 * nj * solved, 0.0);
-        work.reactions.resize(6 * nj * 2 * cols, 0.0);
     }
     for k in 0..ns {
         let t = sample_time(k, ns, duration);
@@ -661,8 +670,27 @@ fn sub_task(
             }
         }
         if with_reactions {
-            ev.reactions
-                .apply_operator(&work.reactions_work, &work.b, solved, &mut work.out);
+            // The representatives' reactions are needed only as the changes from Δ = 0 to
+            // Δ = ±1, `O (b_r(±1) − b_r(0))`: their right-hand sides at Δ = 0 are subtracted and
+            // not applied (two products per group instead of three).
+            for r in 0..rows {
+                let row = &mut work.b[r * solved + cols..(r + 1) * solved];
+                let (at_zero, at_pm) = row.split_at_mut(nreps);
+                for (d, z) in at_pm.iter_mut().zip(at_zero.iter().cycle()) {
+                    *d -= z;
+                }
+            }
+            let ops = &ev.reactions;
+            let (b, out) = (&work.b, &mut work.out);
+            ops.apply_operator(&work.reactions_work, b, solved, cols, out);
+            let pm = cols + nreps;
+            ops.apply_operator(
+                &work.reactions_work,
+                &b[pm..],
+                solved,
+                2 * nreps,
+                &mut out[pm..],
+            );
         }
         work.scratch.pose = pose;
         // Every column at Δ = ±1 from its representative: X_p(±1) = X_r(±1) + X_p(0) − X_r(0).
@@ -678,29 +706,13 @@ fn sub_task(
                 }
             }
         }
-        if with_reactions {
-            // X_p(±1) per joint wrench row; X_p(0) stays in `work.out`
-            for row in 0..6 * nj {
-                let src = &work.out[row * solved..(row + 1) * solved];
-                let dst = &mut work.reactions[row * 2 * cols..(row + 1) * 2 * cols];
-                let zero = &src[..cols];
-                let reps = |d: usize| &src[cols + d * nreps..cols + (d + 1) * nreps];
-                for si in 0..2 {
-                    groups.expand(
-                        &mut dst[si * cols..(si + 1) * cols],
-                        reps(si + 1),
-                        zero,
-                        reps(0),
-                    );
-                }
-            }
-        }
         let mut finite = all_finite(&work.torques);
         if with_reactions {
+            // every column at Δ = 0 and every group's change
             for row in 0..6 * nj {
                 finite &= all_finite(&work.out[row * solved..row * solved + cols]);
+                finite &= all_finite(&work.out[row * solved + cols + nreps..(row + 1) * solved]);
             }
-            finite &= all_finite(&work.reactions[..6 * nj * 2 * cols]);
         }
         if !finite {
             return Err((k, FailureReason::NonFinite));
@@ -722,15 +734,17 @@ fn sub_task(
             for part in 0..2 {
                 for j in 0..nj {
                     let slot = (part * nj + j) * cols..(part * nj + j + 1) * cols;
-                    // the three components' rows at Δ = 0, +1, −1
+                    // the three components: every column at Δ = 0, the groups' changes to
+                    // Δ = +1 and −1
                     let component = |r: usize| {
-                        let row = 6 * j + 3 * part + r;
-                        let x0 = &work.out[row * solved..row * solved + cols];
-                        let pm = &work.reactions[row * 2 * cols..(row + 1) * 2 * cols];
-                        let (xp, xm) = pm.split_at(cols);
-                        [x0, xp, xm]
+                        let row = &work.out[(6 * j + 3 * part + r) * solved..][..solved];
+                        let (x0, rest) = row.split_at(cols);
+                        let changes = &rest[nreps..];
+                        let (plus, minus) = changes.split_at(nreps);
+                        [x0, plus, minus]
                     };
                     squared_norm_quartic(
+                        &groups.group,
                         [component(0), component(1), component(2)],
                         [
                             &mut q0[slot.clone()],
@@ -787,39 +801,38 @@ fn quadratic_coefficients(x: [&[f64]; 3], c: [&mut [f64]; 3]) {
 }
 
 crate::simd::multiversion! {
-/// `|X(Δ)|²` of a three-component vector whose components are quadratics in `Δ` (each given
-/// by its values at `Δ = 0, 1, −1`, see [`quadratic_coefficients`]), as the five coefficients
-/// of a quartic, per column. Components are summed in order, the first one assigned.
-fn squared_norm_quartic(components: [[&[f64]; 3]; 3], q: [&mut [f64]; 5]) {
+/// `|X(Δ)|²` of a three-component vector whose components are quadratics in `Δ`, as the five
+/// coefficients of a quartic, per column. Component `i` of column `p` is given by its value
+/// `x0` at `Δ = 0` and its group's changes `plus`, `minus` to `Δ = +1` and `−1`:
+/// `X(Δ) = x0 + Δ (plus − minus)/2 + Δ² (plus + minus)/2`. Fused multiply-adds, components
+/// in order.
+fn squared_norm_quartic(group: &[u32], components: [[&[f64]; 3]; 3], q: [&mut [f64]; 5]) {
     let [q0, q1, q2, q3, q4] = q;
     let n = q0.len();
     let (q1, q2, q3, q4) = (&mut q1[..n], &mut q2[..n], &mut q3[..n], &mut q4[..n]);
+    let group = &group[..n];
     let [[a0, ap, am], [b0, bp, bm], [d0, dp, dm]] = components;
-    let (a0, ap, am) = (&a0[..n], &ap[..n], &am[..n]);
-    let (b0, bp, bm) = (&b0[..n], &bp[..n], &bm[..n]);
-    let (d0, dp, dm) = (&d0[..n], &dp[..n], &dm[..n]);
+    let (a0, b0, d0) = (&a0[..n], &b0[..n], &d0[..n]);
+    let groups = ap.len().min(am.len()).min(bp.len()).min(bm.len()).min(dp.len()).min(dm.len());
+    assert!(group.iter().all(|&g| (g as usize) < groups), "group index out of range");
     #[inline(always)]
-    fn terms(x0: f64, xp: f64, xm: f64) -> [f64; 5] {
-        let c0 = x0;
-        let c1 = 0.5 * (xp - xm);
-        let c2 = 0.5 * (xp + xm) - c0;
-        [
-            c0 * c0,
-            2.0 * c0 * c1,
-            c1 * c1 + 2.0 * c0 * c2,
-            2.0 * c1 * c2,
-            c2 * c2,
-        ]
+    fn coefficients(x0: f64, changes: [&[f64]; 2], g: usize) -> [f64; 3] {
+        // SAFETY: `g` is below the length of both change slices (asserted by the caller);
+        // unchecked loads let the compiler gather them in vectors.
+        let (plus, minus) = unsafe { (*changes[0].get_unchecked(g), *changes[1].get_unchecked(g)) };
+        [x0, 0.5 * (plus - minus), 0.5 * (plus + minus)]
     }
     for p in 0..n {
-        let ta = terms(a0[p], ap[p], am[p]);
-        let tb = terms(b0[p], bp[p], bm[p]);
-        let td = terms(d0[p], dp[p], dm[p]);
-        q0[p] = ta[0] + tb[0] + td[0];
-        q1[p] = ta[1] + tb[1] + td[1];
-        q2[p] = ta[2] + tb[2] + td[2];
-        q3[p] = ta[3] + tb[3] + td[3];
-        q4[p] = ta[4] + tb[4] + td[4];
+        let g = group[p] as usize;
+        let [a0, a1, a2] = coefficients(a0[p], [ap, am], g);
+        let [b0, b1, b2] = coefficients(b0[p], [bp, bm], g);
+        let [d0, d1, d2] = coefficients(d0[p], [dp, dm], g);
+        q0[p] = d0.mul_add(d0, b0.mul_add(b0, a0 * a0));
+        q1[p] = 2.0 * d0.mul_add(d1, b0.mul_add(b1, a0 * a1));
+        let cross = d0.mul_add(d2, b0.mul_add(b2, a0 * a2));
+        q2[p] = d1.mul_add(d1, b1.mul_add(b1, a1.mul_add(a1, 2.0 * cross)));
+        q3[p] = 2.0 * d1.mul_add(d2, b1.mul_add(b2, a1 * a2));
+        q4[p] = d2.mul_add(d2, b2.mul_add(b2, a2 * a2));
     }
 }
 }

@@ -644,13 +644,20 @@ impl ReactionSolver {
         work.unit = unit;
     }
 
-    /// `out = O b` for `m` right-hand sides `b` (`6L × m`, row-major) with the operator of
-    /// [`Self::prepare_operator`]; `out` as in [`Self::solve_prepared`]. Each value is the
-    /// same fused multiply-add chain whatever `m` and the column's position, so a column's
-    /// bits do not depend on its batch.
-    pub fn apply_operator(&self, work: &ReactionWork, b: &[f64], m: usize, out: &mut [f64]) {
+    /// `out = O b` for `m` right-hand sides `b` (`6L` rows of `m` values, `ld` apart) with
+    /// the operator of [`Self::prepare_operator`]; `out` (`6J` rows of `m` values, `ld`
+    /// apart) as in [`Self::solve_prepared`]. Each value is the same fused multiply-add chain
+    /// whatever `m` and the column's position, so a column's bits do not depend on its batch.
+    pub fn apply_operator(
+        &self,
+        work: &ReactionWork,
+        b: &[f64],
+        ld: usize,
+        m: usize,
+        out: &mut [f64],
+    ) {
         let nr = 6 * self.joints.len();
-        apply_operator_kernel(&work.op, nr, work.rows, b, m, out);
+        apply_operator_kernel(&work.op, nr, work.rows, b, ld, m, out);
     }
 }
 
@@ -984,24 +991,33 @@ fn mobility_basis(kin: &[BodyKin], n: usize) -> DMatrix<f64> {
 }
 
 crate::simd::multiversion! {
-/// `out = op · b` (`op` row-major `nr × nk`, `b` row-major `nk × m`, `out` row-major
-/// `nr × m`). Every value is `s = 0; s = fma(op[r][k], b[k][p], s)` for `k = 0, 1, …` —
-/// one exactly rounded chain, the same in every register tile shape and in every
-/// instruction-set version, so a value does not depend on `m` or on the column's position.
-fn apply_operator_kernel(op: &[f64], nr: usize, nk: usize, b: &[f64], m: usize, out: &mut [f64]) {
+/// `out = op · b` (`op` row-major `nr × nk`; `b` `nk × m` and `out` `nr × m`, row-major with
+/// rows `ld` apart). Every value is `s = 0; s = fma(op[r][k], b[k][p], s)` for
+/// `k = 0, 1, …` — one exactly rounded chain, the same in every register tile shape and in
+/// every instruction-set version, so a value does not depend on `m` or on the column's
+/// position.
+fn apply_operator_kernel(
+    op: &[f64],
+    nr: usize,
+    nk: usize,
+    b: &[f64],
+    ld: usize,
+    m: usize,
+    out: &mut [f64],
+) {
     // Wide tiles (3 rows × 64 columns: 24 vector accumulators, each broadcast of `op` feeding
     // eight fused multiply-adds), then one-vector tiles, then single columns.
     let mut c0 = 0;
     while c0 + 8 * LANE <= m {
-        operator_rows::<3, { 8 * LANE }>(op, nr, nk, b, m, out, c0);
+        operator_rows::<3, { 8 * LANE }>(op, nr, nk, b, ld, out, c0);
         c0 += 8 * LANE;
     }
     while c0 + LANE <= m {
-        operator_rows::<6, LANE>(op, nr, nk, b, m, out, c0);
+        operator_rows::<6, LANE>(op, nr, nk, b, ld, out, c0);
         c0 += LANE;
     }
     while c0 < m {
-        operator_rows::<1, 1>(op, nr, nk, b, m, out, c0);
+        operator_rows::<1, 1>(op, nr, nk, b, ld, out, c0);
         c0 += 1;
     }
 }
@@ -1016,17 +1032,17 @@ fn operator_rows<const R: usize, const W: usize>(
     nr: usize,
     nk: usize,
     b: &[f64],
-    m: usize,
+    ld: usize,
     out: &mut [f64],
     c0: usize,
 ) {
     let mut r0 = 0;
     while r0 + R <= nr {
-        operator_tile::<R, W>(op, nk, b, m, out, r0, c0);
+        operator_tile::<R, W>(op, nk, b, ld, out, r0, c0);
         r0 += R;
     }
     while r0 < nr {
-        operator_tile::<1, W>(op, nk, b, m, out, r0, c0);
+        operator_tile::<1, W>(op, nk, b, ld, out, r0, c0);
         r0 += 1;
     }
 }
@@ -1037,14 +1053,14 @@ fn operator_tile<const R: usize, const W: usize>(
     op: &[f64],
     nk: usize,
     b: &[f64],
-    m: usize,
+    ld: usize,
     out: &mut [f64],
     r0: usize,
     c0: usize,
 ) {
     let mut acc = [[0.0f64; W]; R];
     for k in 0..nk {
-        let bk: &[f64; W] = b[k * m + c0..k * m + c0 + W]
+        let bk: &[f64; W] = b[k * ld + c0..k * ld + c0 + W]
             .try_into()
             .expect("a whole tile");
         for (r, a) in acc.iter_mut().enumerate() {
@@ -1055,6 +1071,6 @@ fn operator_tile<const R: usize, const W: usize>(
         }
     }
     for (r, a) in acc.iter().enumerate() {
-        out[(r0 + r) * m + c0..(r0 + r) * m + c0 + W].copy_from_slice(a);
+        out[(r0 + r) * ld + c0..(r0 + r) * ld + c0 + W].copy_from_slice(a);
     }
 }

@@ -396,8 +396,9 @@ fn balanced_witness_has_no_static_torque() {
 
 /// The reaction operator of the grid evaluation (`O`, solved once per sample for the unit
 /// right-hand sides) against the substitution solve of every right-hand side: the same joint
-/// wrenches to rounding; and applied to one column alone, the same bits as within a batch of
-/// 37 (the tiles of the product differ with the batch width, the value may not).
+/// wrenches to rounding; and applied to one column alone or to a block of 20 inside wider rows,
+/// the same bits as within a batch of 37 (the tiles of the product differ with the batch
+/// width, the value may not).
 #[test]
 fn reaction_operator_matches_the_substitution_solve() {
     use counterpoise_dynamics::lu::SmallLu;
@@ -430,7 +431,7 @@ fn reaction_operator_matches_the_substitution_solve() {
             .solve_prepared(&mut work, &mut b.clone(), m, &mut solved);
         ev.reactions.prepare_operator(&mut work);
         let mut applied = vec![0.0; out_rows * m];
-        ev.reactions.apply_operator(&work, &b, m, &mut applied);
+        ev.reactions.apply_operator(&work, &b, m, m, &mut applied);
         let scale = solved.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         assert!(scale > 1.0);
         for (x, y) in solved.iter().zip(&applied) {
@@ -439,9 +440,19 @@ fn reaction_operator_matches_the_substitution_solve() {
         for p in [0, 16, 36] {
             let column: Vec<f64> = (0..rows).map(|r| b[r * m + p]).collect();
             let mut alone = vec![0.0; out_rows];
-            ev.reactions.apply_operator(&work, &column, 1, &mut alone);
+            ev.reactions
+                .apply_operator(&work, &column, 1, 1, &mut alone);
             for r in 0..out_rows {
                 assert_eq!(alone[r].to_bits(), applied[r * m + p].to_bits());
+            }
+        }
+        // a block of columns inside wider rows (rows `m` apart)
+        let mut block = vec![0.0; out_rows * m];
+        ev.reactions
+            .apply_operator(&work, &b[3..], m, 20, &mut block[3..]);
+        for r in 0..out_rows {
+            for p in 3..23 {
+                assert_eq!(block[r * m + p].to_bits(), applied[r * m + p].to_bits());
             }
         }
     }
