@@ -34,7 +34,7 @@ use crate::result::{
     FreeParameter, Iteration, OptimisedCounterweight, OptimisedSpring, OptimisedStatus,
     OptimisedVariant,
 };
-use crate::springs::{SpringValues, realize_springs};
+use crate::springs::{SpringValues, StartRecord, realize_springs, realize_springs_reusing};
 use crate::timing::{StageTime, Stopwatch};
 use crate::verify::verify;
 
@@ -120,6 +120,9 @@ struct Candidate {
     relaxation_status: crate::clarabel_map::ConicStatus,
     relaxation_iterations: u32,
     gap_before: f64,
+    /// The spring realization's local solves for these counterweights (the spring choice
+    /// reuses them).
+    spring_starts: Option<StartRecord>,
 }
 
 /// Optimises one balanced variant (see [`optimise_all`]).
@@ -451,20 +454,22 @@ fn step(
         )));
     };
     let x = problem.lifted(&z);
-    let (mut springs, mut note) = realize_springs(
+    let (mut springs, mut note, mut starts_record) = realize_springs_reusing(
         problem,
         &ctx.basis.unbalanced,
         &x,
         options.spring_starts,
         false,
+        None,
     );
     if springs.is_empty() && !problem.springs.is_empty() {
-        (springs, note) = realize_springs(
+        (springs, note, starts_record) = realize_springs_reusing(
             problem,
             &ctx.basis.unbalanced,
             &x,
             options.spring_starts * 4,
             false,
+            Some(&starts_record),
         );
     }
     let (springs, x_full) = match springs.into_iter().next() {
@@ -508,6 +513,7 @@ fn step(
         relaxation_status: status,
         relaxation_iterations: relaxed.solution.iterations,
         gap_before,
+        spring_starts: Some(starts_record),
     })
 }
 
@@ -919,12 +925,13 @@ fn spring_choice(
     if problem.springs.is_empty() {
         return Some((Vec::new(), cand.x.clone(), None));
     }
-    let (found, _) = realize_springs(
+    let (found, _, _) = realize_springs_reusing(
         problem,
         &ctx.basis.unbalanced,
         &cand.x,
         options.spring_starts * 4,
         false,
+        cand.spring_starts.as_ref(),
     );
     let mut options_found: Vec<crate::springs::Realized> = found;
     if options_found.is_empty() {

@@ -400,6 +400,43 @@ fn values(problem: &VariantProblem, lay: &Layout, y: &DVector<f64>) -> Vec<Sprin
 /// One admissible spring set and the full lifted point with it.
 pub type Realized = (Vec<SpringValues>, DVector<f64>);
 
+/// The local solves of one [`realize_springs_reusing`] call: the lifted point they ran for and,
+/// per start, the point reached with its balance residual and bound excess.
+#[derive(Clone, Debug)]
+pub struct StartRecord {
+    x: DVector<f64>,
+    joint: bool,
+    outcomes: Vec<(DVector<f64>, f64, f64)>,
+    reused: usize,
+}
+
+impl StartRecord {
+    /// Starts whose local solve was taken from the previous record.
+    pub fn reused(&self) -> usize {
+        self.reused
+    }
+
+    /// Whether start `start` (≥ 1) of a call for `x` would repeat the recorded one exactly:
+    /// starts after the first draw their points from the same pseudo-random stream when the
+    /// first start drew the same numbers (it draws a stiffness for each spring whose lifted
+    /// `K` is not positive), and the local solve reads `x` only outside the springs' columns.
+    fn repeats(&self, problem: &VariantProblem, x: &DVector<f64>, joint: bool) -> bool {
+        if joint || self.joint || x.len() != self.x.len() {
+            return false;
+        }
+        let mut spring_column = vec![false; x.len()];
+        for s in &problem.springs {
+            if (x[s.column] > 0.0) != (self.x[s.column] > 0.0) {
+                return false;
+            }
+            for c in s.column..s.column + s.lifted_len() {
+                spring_column[c] = true;
+            }
+        }
+        (0..x.len()).all(|c| spring_column[c] || x[c].to_bits() == self.x[c].to_bits())
+    }
+}
+
 /// Admissible spring sets for the lifted point `x` (its counterweight part is kept), from
 /// `starts` deterministic starts; distinct solutions only, in order of discovery.
 ///
@@ -413,10 +450,33 @@ pub fn realize_springs(
     starts: usize,
     joint: bool,
 ) -> (Vec<Realized>, String) {
+    let (found, note, _) = realize_springs_reusing(problem, b, x, starts, joint, None);
+    (found, note)
+}
+
+/// [`realize_springs`] that takes the local solves of starts after the first from `previous`
+/// where they would repeat exactly (see [`StartRecord`]), and records its own. The result is
+/// the same bits as without `previous`: the spring choice runs four times the starts of the
+/// critical-task pass for the same counterweights, and the pass's starts need not run twice.
+pub fn realize_springs_reusing(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    x: &DVector<f64>,
+    starts: usize,
+    joint: bool,
+    previous: Option<&StartRecord>,
+) -> (Vec<Realized>, String, StartRecord) {
     let lay = layout(problem, joint);
+    let mut record = StartRecord {
+        x: x.clone(),
+        joint,
+        outcomes: Vec::new(),
+        reused: 0,
+    };
     if lay.unknowns == 0 {
-        return (vec![(Vec::new(), x.clone())], String::new());
+        return (vec![(Vec::new(), x.clone())], String::new(), record);
     }
+    let reuse = previous.filter(|p| p.repeats(problem, x, joint));
     let mut rng = SplitMix64::new(0x5917_6e55_0000_0001);
     let mut found: Vec<Realized> = Vec::new();
     let mut best = (f64::INFINITY, f64::INFINITY);
@@ -468,9 +528,22 @@ pub fn realize_springs(
                 y0[u + 1 + k] = x[c.column + 1 + k] / big_r;
             }
         }
-        let target = y0.clone();
-        let (y1, _, _) = levenberg_marquardt(problem, b, x, &lay, y0, Some((&target, 1e-3)));
-        let (y, bal, hinge) = levenberg_marquardt(problem, b, x, &lay, y1, None);
+        let recorded = reuse
+            .and_then(|p| p.outcomes.get(start))
+            .filter(|_| start > 0);
+        let (y, bal, hinge) = match recorded {
+            Some(outcome) => {
+                record.reused += 1;
+                outcome.clone()
+            }
+            None => {
+                let target = y0.clone();
+                let pull = Some((&target, 1e-3));
+                let (y1, _, _) = levenberg_marquardt(problem, b, x, &lay, y0, pull);
+                levenberg_marquardt(problem, b, x, &lay, y1, None)
+            }
+        };
+        record.outcomes.push((y.clone(), bal, hinge));
         if bal < best.0 {
             best = (bal, hinge);
         }
@@ -502,5 +575,5 @@ pub fn realize_springs(
     } else {
         String::new()
     };
-    (found, note)
+    (found, note, record)
 }

@@ -258,3 +258,36 @@ fn the_lifted_radius_check_is_relative_to_the_counterweights_own_mass() {
         .fold(f64::NEG_INFINITY, f64::max);
     assert!((worst - 1e-6).abs() < 1e-9, "largest violation {worst}");
 }
+
+/// The spring choice runs four times the starts of the critical-task pass for the same
+/// counterweights and takes the pass's local solves instead of repeating them: the admissible
+/// spring sets found are the same bits as from scratch, the seven starts after the first are
+/// reused, and a record for other counterweights (or for the joint search) is not.
+#[test]
+fn spring_starts_of_the_pass_are_reused_by_the_choice_exactly() {
+    use counterpoise_optimise::springs::realize_springs_reusing;
+    let json = common::case_json("palletizer.json");
+    let model = common::model(&json);
+    let ctx = counterpoise_optimise::Context::new(&model, None).unwrap();
+    let problem = variant_problem(&ctx, &["m4", "K42"]);
+    let b = &ctx.basis.unbalanced;
+    let x = problem.particular.clone();
+    let (pass, _, record) = realize_springs_reusing(&problem, b, &x, 8, false, None);
+    assert_eq!(record.reused(), 0);
+    let (fresh, _, _) = realize_springs_reusing(&problem, b, &x, 32, false, None);
+    let (reusing, _, again) = realize_springs_reusing(&problem, b, &x, 32, false, Some(&record));
+    assert_eq!(again.reused(), 7);
+    assert!(!fresh.is_empty() && fresh.len() >= pass.len());
+    assert_eq!(format!("{fresh:?}"), format!("{reusing:?}"));
+    // other counterweights: the record does not apply
+    let mut moved = x.clone();
+    let cw = problem.counterweights[0].column;
+    moved[cw] *= 1.5;
+    let (fresh, _, _) = realize_springs_reusing(&problem, b, &moved, 16, false, None);
+    let (reusing, _, other) =
+        realize_springs_reusing(&problem, b, &moved, 16, false, Some(&record));
+    assert_eq!(other.reused(), 0);
+    assert_eq!(format!("{fresh:?}"), format!("{reusing:?}"));
+    let (_, _, joint) = realize_springs_reusing(&problem, b, &x, 16, true, Some(&record));
+    assert_eq!(joint.reused(), 0);
+}
