@@ -90,6 +90,10 @@ struct StatsScratch {
     abs_sum: Vec<f64>,
     /// A spent [`TaskRows`] buffer handed back for the next sub-task.
     rows: Vec<f64>,
+    /// Per reaction row, the bound of its peak over the sub-task.
+    bound: Vec<f64>,
+    /// The active rows' coefficients at two samples and their peaks per task.
+    compact: Vec<f64>,
 }
 
 /// `v` as `n` zeros, reusing its allocation.
@@ -283,7 +287,7 @@ pub(crate) fn evaluate_cyclic(
     };
     let per_sample_stride = params.len() * (3 * na + 10 * nj);
     let groups = InertiaGroups::new(params);
-    let one_sub_task = |work: &mut Work, st: usize| -> SubTaskOutcome {
+    let one_sub_task = |work: &mut Work, st: usize, floor: Option<&[f64]>| -> SubTaskOutcome {
         let (s1, s2) = st_pairs[st];
         let data = match &sub_q[s1] {
             Err(reason) => Err((0, reason.clone())),
@@ -342,6 +346,7 @@ pub(crate) fn evaluate_cyclic(
             params.len(),
             na,
             nj,
+            floor,
             &mut work.stats,
         );
         Ok((rows, users[st].iter().map(|u| u.0).zip(slot).collect()))
@@ -351,7 +356,7 @@ pub(crate) fn evaluate_cyclic(
         GridSink::Table(table) => {
             let computed: Vec<SubTaskOutcome> = (0..st_pairs.len())
                 .into_par_iter()
-                .map_init(Work::default, |work, st| one_sub_task(work, st))
+                .map_init(Work::default, |work, st| one_sub_task(work, st, None))
                 .collect();
             for outcome in computed {
                 match outcome {
@@ -368,13 +373,18 @@ pub(crate) fn evaluate_cyclic(
         GridSink::Maxima(acc) => {
             // Each worker folds its sub-tasks into its own maxima; the merge is order-free
             // (ties to the lowest task), so the result does not depend on the split.
+            //
+            // Two rounds: every `SEED_STRIDE`-th sub-task in full, then the others with the
+            // seeds' reaction peaks as a floor — a joint reaction row whose bound over a
+            // sub-task stays below the peak already reached elsewhere cannot be the maximum,
+            // and its quartics are not evaluated (the maxima are the same bits).
             let empty = IndicatorAccumulator::new(acc.columns, acc.actuators, acc.joints);
-            let (_, maxima, failed, count) = (0..st_pairs.len())
-                .into_par_iter()
+            let round = |sts: Vec<usize>, floor: Option<&[f64]>| {
+                sts.into_par_iter()
                 .fold(
                     || (Work::default(), empty.clone(), Vec::new(), 0usize),
                     |(mut work, mut m, mut failed, mut count), st| {
-                        match one_sub_task(&mut work, st) {
+                        match one_sub_task(&mut work, st, floor) {
                             Ok((rows, assignment)) => {
                                 count += rows.len();
                                 for (w, u) in assignment {
@@ -394,7 +404,16 @@ pub(crate) fn evaluate_cyclic(
                         f1.extend(f2);
                         ((), m.merge(&other), f1, c1 + c2)
                     },
-                );
+                )
+            };
+            let (seeds, rest): (Vec<usize>, Vec<usize>) =
+                (0..st_pairs.len()).partition(|st| st % SEED_STRIDE == 0);
+            let (_, seeded, mut failed, mut count) = round(seeds, None);
+            let floor = (nj > 0).then(|| seeded.reaction_floor(FLOOR_MARGIN));
+            let (_, others, failed_others, count_others) = round(rest, floor.as_deref());
+            failed.extend(failed_others);
+            count += count_others;
+            let maxima = seeded.merge(&others);
             *acc = acc.clone().merge(&maxima);
             failures.extend(failed);
             distinct = count;
@@ -416,11 +435,26 @@ fn task_stats(
     cols: usize,
     na: usize,
     nj: usize,
+    floor: Option<&[f64]>,
     scratch: &mut StatsScratch,
 ) -> TaskRows {
     let nt = tasks.len();
     let tq = na * cols;
     let rq = 2 * nj * cols;
+    // Reaction rows that may reach their floor (see `ReactionFloor`); `None`: every row.
+    let active = match floor {
+        Some(floor) if nj > 0 => Some(reaction_rows_above(
+            coefficients,
+            stride,
+            3 * tq,
+            rq,
+            ns,
+            tasks,
+            floor,
+            &mut scratch.bound,
+        )),
+        _ => None,
+    };
     let sum_sq = zeroed(&mut scratch.sum_sq, nt * tq);
     let peak = zeroed(&mut scratch.peak, nt * tq);
     let total_peak = zeroed(&mut scratch.total_peak, nt * cols);
@@ -471,7 +505,7 @@ fn task_stats(
                         *m = s;
                     }
                 }
-                if nj > 0 {
+                if nj > 0 && active.is_none() {
                     let (c0, rest) = rest.split_at(rq);
                     let (c1, rest) = rest.split_at(rq);
                     let (c2, rest) = rest.split_at(rq);
@@ -496,6 +530,19 @@ fn task_stats(
                 }
             }
         }
+    }
+    if let Some(active) = &active {
+        pruned_reaction_peaks(
+            coefficients,
+            stride,
+            3 * tq,
+            rq,
+            ns,
+            tasks,
+            active,
+            reaction_peak,
+            &mut scratch.compact,
+        );
     }
     let width = 2 * na + 1 + 2 * nj;
     let n = ns.max(1) as f64;
@@ -833,6 +880,133 @@ fn squared_norm_quartic(group: &[u32], components: [[&[f64]; 3]; 3], q: [&mut [f
         q2[p] = d1.mul_add(d1, b1.mul_add(b1, a1.mul_add(a1, 2.0 * cross)));
         q3[p] = 2.0 * d1.mul_add(d2, b1.mul_add(b2, a1 * a2));
         q4[p] = d2.mul_add(d2, b2.mul_add(b2, a2 * a2));
+    }
+}
+}
+
+/// Every how many sub-tasks one is evaluated in full first, to seed the reaction floors.
+const SEED_STRIDE: usize = 8;
+
+/// Relative margin between a reaction row's bound and its floor: far above the rounding of
+/// the bound and of the quartic's evaluation (a few units in the last place), so a row is
+/// skipped only when its peak is certainly below a value reached elsewhere.
+const FLOOR_MARGIN: f64 = 1e-12;
+
+/// The flat indices `row · cols + column` of the reaction rows whose peak over the sub-task can
+/// reach `floor`: per row, `max_k Σ_i |c_i| D^i` over the samples, with `D` the largest `|Δ|`
+/// of the tasks, bounds every task's `|F|²` or `|M|²` (the computed quartic exceeds its exact
+/// value by far less than [`FLOOR_MARGIN`]).
+#[allow(clippy::too_many_arguments)]
+fn reaction_rows_above(
+    coefficients: &[f64],
+    stride: usize,
+    offset: usize,
+    rq: usize,
+    ns: usize,
+    tasks: &[(bool, f64)],
+    floor: &[f64],
+    bound: &mut Vec<f64>,
+) -> Vec<usize> {
+    let d = tasks.iter().fold(0.0f64, |m, &(_, delta)| m.max(delta.abs()));
+    let bound = zeroed(bound, rq);
+    for k in 0..ns {
+        let base = &coefficients[k * stride + offset..k * stride + offset + 5 * rq];
+        quartic_bound_max(base, rq, d, bound);
+    }
+    (0..rq)
+        .filter(|&i| bound[i] * (1.0 + FLOOR_MARGIN) >= floor[i])
+        .collect()
+}
+
+crate::simd::multiversion! {
+/// `bound[i] = max(bound[i], Σ_p |c_p[i]| d^p)` for the five coefficient arrays of `base`.
+fn quartic_bound_max(base: &[f64], rq: usize, d: f64, bound: &mut [f64]) {
+    let (c0, rest) = base.split_at(rq);
+    let (c1, rest) = rest.split_at(rq);
+    let (c2, rest) = rest.split_at(rq);
+    let (c3, c4) = rest.split_at(rq);
+    let bound = &mut bound[..rq];
+    let (c1, c2, c3, c4) = (&c1[..rq], &c2[..rq], &c3[..rq], &c4[..rq]);
+    for i in 0..rq {
+        let b = c4[i]
+            .abs()
+            .mul_add(d, c3[i].abs())
+            .mul_add(d, c2[i].abs())
+            .mul_add(d, c1[i].abs())
+            .mul_add(d, c0[i].abs());
+        if b > bound[i] {
+            bound[i] = b;
+        }
+    }
+}
+}
+
+/// The reaction peaks of the `active` rows only (the others stay 0: below their floor), from
+/// the rows' coefficients gathered per sample into contiguous arrays. Same arithmetic as the
+/// full sweep of [`task_stats`].
+#[allow(clippy::too_many_arguments)]
+fn pruned_reaction_peaks(
+    coefficients: &[f64],
+    stride: usize,
+    offset: usize,
+    rq: usize,
+    ns: usize,
+    tasks: &[(bool, f64)],
+    active: &[usize],
+    reaction_peak: &mut [f64],
+    compact: &mut Vec<f64>,
+) {
+    let n = active.len();
+    if n == 0 {
+        return;
+    }
+    let nt = tasks.len();
+    // [forward sample: 5 × n | reversed sample: 5 × n | peaks: nt × n]
+    let compact = zeroed(compact, 10 * n + nt * n);
+    let (samples, peaks) = compact.split_at_mut(10 * n);
+    let gather = |dst: &mut [f64], kk: usize| {
+        let base = &coefficients[kk * stride + offset..kk * stride + offset + 5 * rq];
+        for p in 0..5 {
+            for (x, &i) in dst[p * n..(p + 1) * n].iter_mut().zip(active) {
+                *x = base[p * rq + i];
+            }
+        }
+    };
+    for k in 0..ns {
+        let (forward, reversed) = samples.split_at_mut(5 * n);
+        gather(forward, k);
+        gather(reversed, ns - 1 - k);
+        for (t, &(rev, delta)) in tasks.iter().enumerate() {
+            let dd = if rev { -delta } else { delta };
+            let c = if rev { &*reversed } else { &*forward };
+            quartic_peak_max(c, n, dd, &mut peaks[t * n..(t + 1) * n]);
+        }
+    }
+    for t in 0..nt {
+        for (p, &i) in active.iter().enumerate() {
+            reaction_peak[t * rq + i] = peaks[t * n + p];
+        }
+    }
+}
+
+crate::simd::multiversion! {
+/// `peak[i] = max(peak[i], ((((c4 Δ + c3) Δ + c2) Δ + c1) Δ + c0)[i])` by fused multiply-adds
+/// (the arithmetic of [`task_stats`]), for the five contiguous coefficient arrays of `c`.
+fn quartic_peak_max(c: &[f64], n: usize, dd: f64, peak: &mut [f64]) {
+    let (c0, rest) = c.split_at(n);
+    let (c1, rest) = rest.split_at(n);
+    let (c2, rest) = rest.split_at(n);
+    let (c3, c4) = rest.split_at(n);
+    let (c4, peak) = (&c4[..n], &mut peak[..n]);
+    for i in 0..n {
+        let v = c4[i]
+            .mul_add(dd, c3[i])
+            .mul_add(dd, c2[i])
+            .mul_add(dd, c1[i])
+            .mul_add(dd, c0[i]);
+        if v > peak[i] {
+            peak[i] = v;
+        }
     }
 }
 }

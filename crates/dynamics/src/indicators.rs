@@ -354,6 +354,24 @@ impl IndicatorAccumulator {
         }
     }
 
+    /// Per joint reaction row and column (`[force/moment][joint][column]`), the square of
+    /// the peak reached so far less a relative margin: a sub-task whose rows stay below it
+    /// cannot change the maxima (0 where no task has run).
+    pub(crate) fn reaction_floor(&self, margin: f64) -> Vec<f64> {
+        let slots = self.slots();
+        let rows = 2 * self.joints;
+        let mut floor = vec![0.0; rows * self.columns];
+        for (c, best) in self.best.chunks_exact(slots).enumerate() {
+            for r in 0..rows {
+                let v = best[2 + 2 * self.actuators + r].0;
+                if v.is_finite() && v > 0.0 {
+                    floor[r * self.columns + c] = v * v * (1.0 - margin);
+                }
+            }
+        }
+        floor
+    }
+
     /// Combines the maxima of two disjoint sets of tasks.
     pub fn merge(mut self, other: &IndicatorAccumulator) -> IndicatorAccumulator {
         for (a, b) in self.best.iter_mut().zip(&other.best) {
