@@ -704,15 +704,16 @@ fn sub_task(
                             work.torques[a * cols + c] = torque;
                         }
                     }
-                    if with_reactions {
-                        ev.reactions.subtract_actuators(
-                            &work.reactions_work,
-                            &work.kin,
-                            &qu,
-                            &mut w[c..],
-                            row_stride,
-                        );
-                    }
+                }
+                if with_reactions {
+                    ev.reactions.subtract_actuators_batch(
+                        &work.reactions_work,
+                        &work.kin,
+                        &work.qb,
+                        nc,
+                        w,
+                        row_stride,
+                    );
                 }
             }
         }

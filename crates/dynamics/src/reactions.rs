@@ -544,6 +544,49 @@ impl ReactionSolver {
         }
     }
 
+    /// [`Self::subtract_actuators`] for `nc` columns at once: actuator forces `qu` (`n × nc`,
+    /// row-major) and right-hand sides `b` (`6L` rows of `nc` values, `stride` apart). Each
+    /// value receives the same operations in the same order as column by column.
+    pub fn subtract_actuators_batch(
+        &self,
+        work: &ReactionWork,
+        kin: &[BodyKin],
+        qu: &[f64],
+        nc: usize,
+        b: &mut [f64],
+        stride: usize,
+    ) {
+        for (&(act, joint), &kappa) in self.actuated.iter().zip(&work.kappas) {
+            let j = &self.joints[joint];
+            let f = &work.frames[joint];
+            let forces = &qu[act * nc..(act + 1) * nc];
+            for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
+                let BodyId::Body(bi) = j.bodies[side] else {
+                    continue;
+                };
+                if j.kind == JointKind::Prismatic {
+                    let d = f.point - kin[bi].p;
+                    for (c, &q) in forces.iter().enumerate() {
+                        let force = f.axis * (sign * (q / kappa));
+                        let moment = d.cross(&force);
+                        for r in 0..3 {
+                            b[(6 * bi + r) * stride + c] -= force[r];
+                            b[(6 * bi + 3 + r) * stride + c] -= moment[r];
+                        }
+                    }
+                } else {
+                    for r in 0..3 {
+                        let axis = f.axis[r];
+                        let row = &mut b[(6 * bi + 3 + r) * stride..][..nc];
+                        for (x, &q) in row.iter_mut().zip(forces) {
+                            *x -= sign * (q / kappa) * axis;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// Solves a prepared sample for `m` right-hand sides `b` (`6L × m`, row-major; destroyed)
     /// and writes per joint the force and moment vectors into `out` (`6J × m`, row-major: row
     /// `6j + r` holds component `r` of joint `j`'s force for `r < 3`, of its moment otherwise).
