@@ -381,30 +381,30 @@ pub(crate) fn evaluate_cyclic(
             let empty = IndicatorAccumulator::new(acc.columns, acc.actuators, acc.joints);
             let round = |sts: Vec<usize>, floor: Option<&[f64]>| {
                 sts.into_par_iter()
-                .fold(
-                    || (Work::default(), empty.clone(), Vec::new(), 0usize),
-                    |(mut work, mut m, mut failed, mut count), st| {
-                        match one_sub_task(&mut work, st, floor) {
-                            Ok((rows, assignment)) => {
-                                count += rows.len();
-                                for (w, u) in assignment {
-                                    m.add_rows(w, rows.task(u));
+                    .fold(
+                        || (Work::default(), empty.clone(), Vec::new(), 0usize),
+                        |(mut work, mut m, mut failed, mut count), st| {
+                            match one_sub_task(&mut work, st, floor) {
+                                Ok((rows, assignment)) => {
+                                    count += rows.len();
+                                    for (w, u) in assignment {
+                                        m.add_rows(w, rows.task(u));
+                                    }
+                                    work.stats.rows = rows.data;
                                 }
-                                work.stats.rows = rows.data;
+                                Err(f) => failed.extend(f),
                             }
-                            Err(f) => failed.extend(f),
-                        }
-                        (work, m, failed, count)
-                    },
-                )
-                .map(|(_, m, failed, count)| ((), m, failed, count))
-                .reduce(
-                    || ((), empty.clone(), Vec::new(), 0usize),
-                    |(_, m, mut f1, c1), (_, other, f2, c2)| {
-                        f1.extend(f2);
-                        ((), m.merge(&other), f1, c1 + c2)
-                    },
-                )
+                            (work, m, failed, count)
+                        },
+                    )
+                    .map(|(_, m, failed, count)| ((), m, failed, count))
+                    .reduce(
+                        || ((), empty.clone(), Vec::new(), 0usize),
+                        |(_, m, mut f1, c1), (_, other, f2, c2)| {
+                            f1.extend(f2);
+                            ((), m.merge(&other), f1, c1 + c2)
+                        },
+                    )
             };
             let (seeds, rest): (Vec<usize>, Vec<usize>) =
                 (0..st_pairs.len()).partition(|st| st % SEED_STRIDE == 0);
@@ -908,7 +908,9 @@ fn reaction_rows_above(
     floor: &[f64],
     bound: &mut Vec<f64>,
 ) -> Vec<usize> {
-    let d = tasks.iter().fold(0.0f64, |m, &(_, delta)| m.max(delta.abs()));
+    let d = tasks
+        .iter()
+        .fold(0.0f64, |m, &(_, delta)| m.max(delta.abs()));
     let bound = zeroed(bound, rq);
     for k in 0..ns {
         let base = &coefficients[k * stride + offset..k * stride + offset + 5 * rq];

@@ -72,7 +72,6 @@ impl Default for OptimiseOptions {
 struct Run {
     elements: Vec<String>,
     class: counterpoise_balance::Class,
-    free_components: Vec<Vec<(String, f64)>>,
     problem: Option<VariantProblem>,
     working: Vec<usize>,
     iterations: Vec<Iteration>,
@@ -326,11 +325,6 @@ fn new_run(ctx: &Context, v: &VariantResult, options: &OptimiseOptions) -> Run {
     Run {
         elements: v.elements.iter().map(|e| e.label.clone()).collect(),
         class: v.class,
-        free_components: v
-            .free_directions
-            .iter()
-            .map(|f| f.components.clone())
-            .collect(),
         problem,
         working: working.into_iter().collect(),
         iterations: Vec::new(),
@@ -796,9 +790,13 @@ fn interval(problem: &VariantProblem, x: &DVector<f64>, direction: &DVector<f64>
     ends
 }
 
+/// The coordinates of `x` along the free directions of the variant's balanced family, each
+/// with the interval over which the bounds hold (the others held). `names` are the lifted
+/// variables of the set: each direction is labelled from its own column of the nullspace (the
+/// balance search's report may list its directions in another basis).
 fn free_parameters(
     problem: &VariantProblem,
-    components: &[Vec<(String, f64)>],
+    names: &[String],
     x: &DVector<f64>,
 ) -> Vec<FreeParameter> {
     // The balance search's free directions (the search itself may run on a restricted family).
@@ -807,6 +805,11 @@ fn free_parameters(
     if d == 0 {
         return Vec::new();
     }
+    let components: Vec<Vec<(String, f64)>> =
+        counterpoise_balance::relations::free_directions(&problem.solution, names, &[])
+            .into_iter()
+            .map(|f| f.components)
+            .collect();
     // Coordinates of x in the family: least squares on N (exact: x is in the family).
     let delta = x - &problem.solution.particular;
     let z = n
@@ -1042,7 +1045,12 @@ fn record(
             anchor_b: s.anchor_b,
         })
         .collect();
-    out.free_parameters = free_parameters(problem, &run.free_components, &cand.x);
+    let names: Vec<String> = problem
+        .set
+        .iter()
+        .flat_map(|&e| ctx.catalogue.entries[e].variables.clone())
+        .collect();
+    out.free_parameters = free_parameters(problem, &names, &cand.x);
     out.lower_bound = cand.bound_certified.then_some(cand.lower_bound);
     let ind = match indicators {
         Some(Ok(i)) => i,

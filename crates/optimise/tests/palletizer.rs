@@ -291,3 +291,73 @@ fn spring_starts_of_the_pass_are_reused_by_the_choice_exactly() {
     let (_, _, joint) = realize_springs_reusing(&problem, b, &x, 16, true, Some(&record));
     assert_eq!(joint.reused(), 0);
 }
+
+/// The free parameters of `{m3, m5}` against the case's bounds by hand (mass ≤ 500 kg, radius
+/// ≤ 0.5 m): each free direction moves one lifted coordinate with the others held, so
+/// - along `m5` (mass, first moment `μ5` held) the mass may range over
+///   `[|μ5| / 0.5, 500]` (the radius `|μ5|/m` reaches 0.5 m at the lower end);
+/// - along `m3·r3x` (mass `m3` and `μ3y` held) `|μ3| ≤ 0.5·m3` gives
+///   `μ3x ∈ ±√((0.5·m3)² − μ3y²)`, and likewise along `m3·r3y` (also for `{m3, K43}`).
+///
+/// The values are the coordinates of the optimum, and every direction moves a counterweight.
+/// For `{m3, K43}` the directions made of spring coordinates alone do not. (Each direction
+/// is labelled from its own column: labels taken from the balance search's report, which may
+/// list its directions in another order, once named `m5`'s interval `m3·r3y`.)
+#[test]
+fn free_parameter_intervals_match_the_bounds_by_hand() {
+    let json = common::case_json("palletizer.json");
+    let model = common::model(&json);
+    let (_, results) = common::optimise(
+        &model,
+        &[&["m3", "m5"], &["m3", "K43"]],
+        &OptimiseOptions::default(),
+    );
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * b.abs().max(1.0);
+    let mut checked = 0;
+    for v in &results {
+        assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.elements);
+        let cw = |label: &str| v.counterweights.iter().find(|c| c.label == label);
+        let (m3, mu3) = {
+            let c = cw("m3").unwrap();
+            (c.mass, [c.mass * c.offset[0], c.mass * c.offset[1]])
+        };
+        for fp in &v.free_parameters {
+            let names: Vec<&str> = fp.components.iter().map(|(n, _)| n.as_str()).collect();
+            let spring_only = names.iter().all(|n| n.starts_with('K'));
+            assert_eq!(fp.moves_counterweights, !spring_only, "{names:?}");
+            let expected = match names.as_slice() {
+                ["m5"] => {
+                    let c = cw("m5").unwrap();
+                    let mu = (c.mass * c.offset[0]).hypot(c.mass * c.offset[1]);
+                    Some((c.mass, [mu / 0.5, 500.0]))
+                }
+                ["m3·r3x"] => {
+                    let half = (0.25 * m3 * m3 - mu3[1] * mu3[1]).sqrt();
+                    Some((mu3[0], [-half, half]))
+                }
+                ["m3·r3y"] => {
+                    let half = (0.25 * m3 * m3 - mu3[0] * mu3[0]).sqrt();
+                    Some((mu3[1], [-half, half]))
+                }
+                _ => None,
+            };
+            if let Some((value, [lo, hi])) = expected {
+                assert!(close(fp.value, value), "{names:?}: {} vs {value}", fp.value);
+                assert!(
+                    close(fp.interval[0], lo),
+                    "{names:?}: {:?} vs {lo}",
+                    fp.interval
+                );
+                assert!(
+                    close(fp.interval[1], hi),
+                    "{names:?}: {:?} vs {hi}",
+                    fp.interval
+                );
+                checked += 1;
+            }
+        }
+    }
+    // m5, m3·r3x, m3·r3y of {m3, m5}; m3·r3y of {m3, K43} (its m3·r3x direction also moves
+    // spring coordinates)
+    assert_eq!(checked, 4);
+}

@@ -65,6 +65,18 @@ fn a_joint_idle_in_the_unbalanced_robot_counts_when_it_gets_loaded() {
     assert_eq!(report.value, dr);
 }
 
+/// Peaks that do not match the unbalanced robot's joints one for one have no ΔR: one value
+/// too many (forces or moments) or a robot without reaction peaks.
+#[test]
+fn delta_r_needs_one_peak_per_joint() {
+    let ub = unbalanced(&[(100.0, 10.0), (300.0, 30.0)]);
+    assert!(delta_r(&ub, &[150.0, 240.0], &[10.0, 36.0]).is_some());
+    assert_eq!(delta_r(&ub, &[150.0, 240.0, 1.0], &[10.0, 36.0]), None);
+    assert_eq!(delta_r(&ub, &[150.0, 240.0], &[10.0, 36.0, 1.0]), None);
+    assert_eq!(delta_r(&ub, &[150.0], &[10.0, 36.0]), None);
+    assert_eq!(delta_r(&unbalanced(&[]), &[], &[]), None);
+}
+
 #[test]
 fn the_spring_option_with_the_lowest_delta_r_is_kept() {
     // Three realizations with ΔR 12, 3 and 40 %: the second is the one to keep, whichever
