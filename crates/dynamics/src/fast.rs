@@ -465,7 +465,6 @@ fn task_stats(
     // (Blocking the columns so that a block's sums stay in L2 was measured slower: the
     // coefficients are then read in short strided runs.)
     {
-        let (b0, b1) = (0, cols);
         for k in 0..ns {
             for (t, &(rev, delta)) in tasks.iter().enumerate() {
                 let dd = if rev { -delta } else { delta };
@@ -475,10 +474,9 @@ fn task_stats(
                 let (t0, rest) = base.split_at(tq);
                 let (t1, rest) = rest.split_at(tq);
                 let (t2, rest) = rest.split_at(tq);
-                let abs_sum = &mut abs_sum[b0..b1];
                 abs_sum.fill(0.0);
                 for a in 0..na {
-                    let r = a * cols + b0..a * cols + b1;
+                    let r = a * cols..(a + 1) * cols;
                     let tau = &mut tau[r.clone()];
                     let (t0, t1, t2) = (&t0[r.clone()], &t1[r.clone()], &t2[r.clone()]);
                     let ss = &mut sum_sq[t * tq..(t + 1) * tq][r.clone()];
@@ -497,7 +495,7 @@ fn task_stats(
                         *s += x.abs();
                     }
                 }
-                for (m, &s) in total_peak[t * cols + b0..t * cols + b1]
+                for (m, &s) in total_peak[t * cols..(t + 1) * cols]
                     .iter_mut()
                     .zip(abs_sum.iter())
                 {
@@ -511,22 +509,7 @@ fn task_stats(
                     let (c2, rest) = rest.split_at(rq);
                     let (c3, c4) = rest.split_at(rq);
                     let pk = &mut reaction_peak[t * rq..(t + 1) * rq];
-                    for row in 0..2 * nj {
-                        let r = row * cols + b0..row * cols + b1;
-                        let pk = &mut pk[r.clone()];
-                        let (c0, c1, c2) = (&c0[r.clone()], &c1[r.clone()], &c2[r.clone()]);
-                        let (c3, c4) = (&c3[r.clone()], &c4[r]);
-                        for i in 0..pk.len() {
-                            let v = c4[i]
-                                .mul_add(dd, c3[i])
-                                .mul_add(dd, c2[i])
-                                .mul_add(dd, c1[i])
-                                .mul_add(dd, c0[i]);
-                            if v > pk[i] {
-                                pk[i] = v;
-                            }
-                        }
-                    }
+                    quartic_peak_update([c0, c1, c2, c3, c4], dd, pk);
                 }
             }
         }
@@ -1000,7 +983,16 @@ fn quartic_peak_max(c: &[f64], n: usize, dd: f64, peak: &mut [f64]) {
     let (c1, rest) = rest.split_at(n);
     let (c2, rest) = rest.split_at(n);
     let (c3, c4) = rest.split_at(n);
-    let (c4, peak) = (&c4[..n], &mut peak[..n]);
+    quartic_peak_update([c0, c1, c2, c3, c4], dd, peak);
+}
+}
+
+/// `peak[i] = max(peak[i], ((((c4 Δ + c3) Δ + c2) Δ + c1) Δ + c0)[i])` by fused multiply-adds,
+/// for the coefficient arrays `c = [c0, …, c4]` (as long as `peak`).
+#[inline(always)]
+fn quartic_peak_update(c: [&[f64]; 5], dd: f64, peak: &mut [f64]) {
+    let n = peak.len();
+    let [c0, c1, c2, c3, c4] = c.map(|x| &x[..n]);
     for i in 0..n {
         let v = c4[i]
             .mul_add(dd, c3[i])
@@ -1011,5 +1003,4 @@ fn quartic_peak_max(c: &[f64], n: usize, dd: f64, peak: &mut [f64]) {
             peak[i] = v;
         }
     }
-}
 }
