@@ -441,7 +441,7 @@ fn task_stats(
     let nt = tasks.len();
     let tq = na * cols;
     let rq = 2 * nj * cols;
-    // Reaction rows that may reach their floor (see `ReactionFloor`); `None`: every row.
+    // Reaction rows that may reach their floor (see `reaction_rows_above`); `None`: every row.
     let active = match floor {
         Some(floor) if nj > 0 => Some(reaction_rows_above(
             coefficients,

@@ -3,7 +3,7 @@
 //!
 //! Everything is linear in lifted inertial parameters ([`params`]): the kinematics and the
 //! regressor of a sample are computed once and shared by every parameter vector evaluated
-//! with it ([`runner`]). Entry points: [`evaluate`] (the `evaluate` command),
+//! with it ([`runner`]). Entry points: [`evaluate()`] (the `evaluate` command),
 //! [`task_series`] (one task's time series), [`evaluate_grid`] (many parameter vectors).
 
 // Index loops over small fixed-size numeric arrays read like the formulas they implement, and
