@@ -311,6 +311,12 @@ fn spring_starts_of_the_pass_are_reused_by_the_choice_exactly() {
     assert_eq!(format!("{fresh:?}"), format!("{reusing:?}"));
     let (_, _, joint) = realize_springs_reusing(&problem, b, &x, 16, true, Some(&record));
     assert_eq!(joint.reused(), 0);
+    // nor does the joint search's record for the springs alone
+    let (fresh, _, _) = realize_springs_reusing(&problem, b, &x, 16, false, None);
+    let (reusing, _, after_joint) =
+        realize_springs_reusing(&problem, b, &x, 16, false, Some(&joint));
+    assert_eq!(after_joint.reused(), 0);
+    assert_eq!(format!("{fresh:?}"), format!("{reusing:?}"));
 }
 
 /// The free parameters of `{m3, m5}` against the case's bounds by hand (mass ≤ 500 kg, radius
