@@ -311,6 +311,21 @@ fn spring_starts_of_the_pass_are_reused_by_the_choice_exactly() {
     assert_eq!(format!("{fresh:?}"), format!("{reusing:?}"));
     let (_, _, joint) = realize_springs_reusing(&problem, b, &x, 16, true, Some(&record));
     assert_eq!(joint.reused(), 0);
+    // nor one whose first start drew a stiffness the other did not (lifted K = 0: the
+    // pseudo-random stream is one draw ahead from the second start on)
+    let column = problem.springs[0].column;
+    let (mut positive, mut zero) = (x.clone(), x.clone());
+    positive[column] = 5000.0;
+    zero[column] = 0.0;
+    let (_, _, record_positive) = realize_springs_reusing(&problem, b, &positive, 8, false, None);
+    let (_, _, record_zero) = realize_springs_reusing(&problem, b, &zero, 8, false, None);
+    for (point, previous) in [(&positive, &record_zero), (&zero, &record_positive)] {
+        let (fresh, _, _) = realize_springs_reusing(&problem, b, point, 16, false, None);
+        let (reusing, _, other) =
+            realize_springs_reusing(&problem, b, point, 16, false, Some(previous));
+        assert_eq!(other.reused(), 0);
+        assert_eq!(format!("{fresh:?}"), format!("{reusing:?}"));
+    }
     // nor does the joint search's record for the springs alone
     let (fresh, _, _) = realize_springs_reusing(&problem, b, &x, 16, false, None);
     let (reusing, _, after_joint) =
