@@ -504,12 +504,8 @@ fn task_stats(
                     }
                 }
                 if nj > 0 && active.is_none() {
-                    let (c0, rest) = rest.split_at(rq);
-                    let (c1, rest) = rest.split_at(rq);
-                    let (c2, rest) = rest.split_at(rq);
-                    let (c3, c4) = rest.split_at(rq);
                     let pk = &mut reaction_peak[t * rq..(t + 1) * rq];
-                    quartic_peak_update([c0, c1, c2, c3, c4], dd, pk);
+                    quartic_peak_update(quartic_arrays(rest, rq), dd, pk);
                 }
             }
         }
@@ -907,12 +903,8 @@ fn reaction_rows_above(
 crate::simd::multiversion! {
 /// `bound[i] = max(bound[i], Σ_p |c_p[i]| d^p)` for the five coefficient arrays of `base`.
 fn quartic_bound_max(base: &[f64], rq: usize, d: f64, bound: &mut [f64]) {
-    let (c0, rest) = base.split_at(rq);
-    let (c1, rest) = rest.split_at(rq);
-    let (c2, rest) = rest.split_at(rq);
-    let (c3, c4) = rest.split_at(rq);
+    let [c0, c1, c2, c3, c4] = quartic_arrays(base, rq);
     let bound = &mut bound[..rq];
-    let (c1, c2, c3, c4) = (&c1[..rq], &c2[..rq], &c3[..rq], &c4[..rq]);
     for i in 0..rq {
         let b = c4[i]
             .abs()
@@ -979,12 +971,14 @@ crate::simd::multiversion! {
 /// `peak[i] = max(peak[i], ((((c4 Δ + c3) Δ + c2) Δ + c1) Δ + c0)[i])` by fused multiply-adds
 /// (the arithmetic of [`task_stats`]), for the five contiguous coefficient arrays of `c`.
 fn quartic_peak_max(c: &[f64], n: usize, dd: f64, peak: &mut [f64]) {
-    let (c0, rest) = c.split_at(n);
-    let (c1, rest) = rest.split_at(n);
-    let (c2, rest) = rest.split_at(n);
-    let (c3, c4) = rest.split_at(n);
-    quartic_peak_update([c0, c1, c2, c3, c4], dd, peak);
+    quartic_peak_update(quartic_arrays(c, n), dd, peak);
 }
+}
+
+/// The five coefficient arrays `[c0, …, c4]` of `n` values each at the start of `c`.
+#[inline(always)]
+fn quartic_arrays(c: &[f64], n: usize) -> [&[f64]; 5] {
+    std::array::from_fn(|p| &c[p * n..(p + 1) * n])
 }
 
 /// `peak[i] = max(peak[i], ((((c4 Δ + c3) Δ + c2) Δ + c1) Δ + c0)[i])` by fused multiply-adds,
