@@ -349,7 +349,7 @@ impl ReactionSolver {
             .collect();
         for (c, &p) in columns.iter().enumerate() {
             required_wrenches_with(&reg.wrench, &frames, params, p, &mut w);
-            self.subtract_actuators(work, kin, &actuator_forces[c], &mut w, 1);
+            self.subtract_actuators_batch(work, kin, &actuator_forces[c], 1, &mut w, 1);
             for (r, &x) in w.iter().enumerate() {
                 b[r * m + c] = x;
             }
@@ -511,42 +511,9 @@ impl ReactionSolver {
         );
     }
 
-    /// Subtracts the actuator wrenches of actuator forces `qu` from the right-hand side `b`
-    /// (one column of `6L` values `stride` apart) of a prepared sample.
-    pub fn subtract_actuators(
-        &self,
-        work: &ReactionWork,
-        kin: &[BodyKin],
-        qu: &[f64],
-        b: &mut [f64],
-        stride: usize,
-    ) {
-        for (&(act, joint), &kappa) in self.actuated.iter().zip(&work.kappas) {
-            let j = &self.joints[joint];
-            let f = &work.frames[joint];
-            let tau = qu[act] / kappa;
-            for (side, sign) in [(1usize, 1.0), (0, -1.0)] {
-                if let BodyId::Body(bi) = j.bodies[side] {
-                    if j.kind == JointKind::Prismatic {
-                        let force = f.axis * (sign * tau);
-                        let moment = (f.point - kin[bi].p).cross(&force);
-                        for r in 0..3 {
-                            b[(6 * bi + r) * stride] -= force[r];
-                            b[(6 * bi + 3 + r) * stride] -= moment[r];
-                        }
-                    } else {
-                        for r in 0..3 {
-                            b[(6 * bi + 3 + r) * stride] -= sign * tau * f.axis[r];
-                        }
-                    }
-                }
-            }
-        }
-    }
-
-    /// [`Self::subtract_actuators`] for `nc` columns at once: actuator forces `qu` (`n × nc`,
-    /// row-major) and right-hand sides `b` (`6L` rows of `nc` values, `stride` apart). Each
-    /// value receives the same operations in the same order as column by column.
+    /// Subtracts the actuator wrenches of actuator forces `qu` (`n × nc`, row-major) from the
+    /// right-hand sides `b` (`6L` rows of `nc` values, `stride` apart) of a prepared sample.
+    /// Each value receives the same operations in the same order whatever `nc`.
     pub fn subtract_actuators_batch(
         &self,
         work: &ReactionWork,
