@@ -17,6 +17,13 @@ use crate::linear::{FIXED_TOL, LinearSolution};
 pub struct FreeDirection {
     /// Lifted variable → component (largest component scaled to ±1; negligible ones omitted).
     pub components: Vec<(String, f64)>,
+    /// Indices of the lifted variables listed in `components`, in the same order.
+    #[serde(skip)]
+    pub variables: Vec<usize>,
+    /// The whole direction over the set's lifted variables, with the same normalisation
+    /// (negligible components kept): the family is `x_p + Σ t_k·direction_k`.
+    #[serde(skip)]
+    pub direction: DVector<f64>,
     /// For a one-dimensional family `x_p + t·n`: the interval of `t` over which every installed
     /// mass and stiffness stays positive (`None` = unbounded on that side). Lifted positivity only;
     /// spring realizability is checked on the witness.
@@ -149,16 +156,20 @@ pub fn free_directions(
                 if v.abs() > acc.1 { (j, v.abs()) } else { acc }
             });
             let norm = column[biggest.0];
-            let components = (0..column.len())
+            let direction: DVector<f64> = column.map(|v| v / norm);
+            let variables: Vec<usize> = (0..column.len())
                 .filter(|&j| scaled[j].abs() > FIXED_TOL * biggest.1.max(f64::MIN_POSITIVE) * 1e3)
-                .map(|j| (names[j].clone(), column[j] / norm))
+                .collect();
+            let components = variables
+                .iter()
+                .map(|&j| (names[j].clone(), direction[j]))
                 .collect();
             let positive_interval = one_dimensional.then(|| {
                 let mut lo: Option<f64> = None;
                 let mut hi: Option<f64> = None;
                 for &j in positive_variables {
                     // x_p[j] + t·n[j]/norm > 0
-                    let slope = column[j] / norm;
+                    let slope = direction[j];
                     if (column[j] * solution.column_scale[j]).abs() <= FIXED_TOL {
                         continue;
                     }
@@ -173,6 +184,8 @@ pub fn free_directions(
             });
             FreeDirection {
                 components,
+                variables,
+                direction,
                 positive_interval,
             }
         })

@@ -19,7 +19,7 @@ use counterpoise_balance::{Attachment, Status, VariantResult};
 use counterpoise_dynamics::params::{Counterweight, ParameterSet, Spring, Variant};
 use counterpoise_dynamics::runner::Workspace;
 use counterpoise_dynamics::{EvaluateOptions, Evaluator, Indicators, evaluate_grid_indicators};
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -184,7 +184,20 @@ pub fn optimise_all_reporting(
         .filter(|v| v.status == Status::Balanced)
         .map(|v| new_run(ctx, v, options))
         .collect();
+    critical_task_loop(ctx, &mut runs, options, &mut timings, progress);
+    let out = finish(ctx, runs, options, &mut timings, progress);
+    (out, timings)
+}
 
+/// The passes of the critical-task loop (Proc-5…8): every run leaves it converged, stopped
+/// after `max_iterations` passes, discarded or undecided.
+fn critical_task_loop(
+    ctx: &Context,
+    runs: &mut [Run],
+    options: &OptimiseOptions,
+    timings: &mut StageTimings,
+    progress: ProgressSink<'_>,
+) {
     for _pass in 0..options.max_iterations.max(1) {
         let active: Vec<usize> = (0..runs.len())
             .filter(|&k| runs[k].state == State::Running)
@@ -234,7 +247,7 @@ pub fn optimise_all_reporting(
             timings.passes,
             evaluated.len(),
         );
-        let dyn_variants = candidate_variants(&runs, &evaluated);
+        let dyn_variants = candidate_variants(runs, &evaluated);
         let indicators = grid_indicators(ctx, &dyn_variants, false);
         timings.loop_grid += started.elapsed();
         let indicators = match indicators {
@@ -274,13 +287,11 @@ pub fn optimise_all_reporting(
             }
         }
     }
-    for run in &mut runs {
+    for run in runs.iter_mut() {
         if run.state == State::Running {
             run.state = State::Stopped;
         }
     }
-    let out = finish(ctx, runs, options, &mut timings, progress);
-    (out, timings)
 }
 
 fn new_run(ctx: &Context, v: &VariantResult, options: &OptimiseOptions) -> Run {
@@ -763,7 +774,8 @@ fn interval(problem: &VariantProblem, x: &DVector<f64>, direction: &DVector<f64>
         let mut inside = 0.0;
         let mut step = 1e-6;
         let mut outside = None;
-        while step < 1e12 {
+        // Doublings from 1e-6 up to about 1.2e12: beyond that the side is unbounded.
+        for _ in 0..60 {
             if ok(sign * step) {
                 inside = step;
                 step *= 2.0;
@@ -792,52 +804,43 @@ fn interval(problem: &VariantProblem, x: &DVector<f64>, direction: &DVector<f64>
 
 /// The coordinates of `x` along the free directions of the variant's balanced family, each
 /// with the interval over which the bounds hold (the others held). `names` are the lifted
-/// variables of the set: each direction is labelled from its own column of the nullspace (the
+/// variables of the set. The directions are the balance crate's, normalised as it reports them
+/// (largest column-scaled component ±1), one per column of the optimiser's own nullspace (the
 /// balance search's report may list its directions in another basis).
 fn free_parameters(
     problem: &VariantProblem,
     names: &[String],
     x: &DVector<f64>,
 ) -> Vec<FreeParameter> {
-    // The balance search's free directions (the search itself may run on a restricted family).
-    let n = &problem.solution.nullspace;
-    let d = n.ncols();
-    if d == 0 {
+    let directions =
+        counterpoise_balance::relations::free_directions(&problem.solution, names, &[]);
+    if directions.is_empty() {
         return Vec::new();
     }
-    let components: Vec<Vec<(String, f64)>> =
-        counterpoise_balance::relations::free_directions(&problem.solution, names, &[])
-            .into_iter()
-            .map(|f| f.components)
-            .collect();
-    // Coordinates of x in the family: least squares on N (exact: x is in the family).
+    // Coordinates of x in the family: least squares on the directions (exact: x is in it).
+    let basis = DMatrix::from_columns(
+        &directions
+            .iter()
+            .map(|f| f.direction.clone())
+            .collect::<Vec<_>>(),
+    );
     let delta = x - &problem.solution.particular;
-    let z = n
-        .clone()
+    let values = basis
         .svd(true, true)
         .solve(&delta, 1e-12)
-        .unwrap_or_else(|_| DVector::zeros(d));
+        .unwrap_or_else(|_| DVector::zeros(directions.len()));
     let cw_rows = problem.cw_rows();
-    let scale = &problem.solution.column_scale;
-    (0..d)
-        .map(|k| {
-            let col = n.column(k);
-            // Normalise like the balance crate: largest scaled component → ±1.
-            let (big, _) = (0..col.len()).fold((0, 0.0f64), |acc, j| {
-                let v = (col[j] * scale[j]).abs();
-                if v > acc.1 { (j, v) } else { acc }
-            });
-            let norm = col[big];
-            let direction: DVector<f64> = col.map(|v| v / norm);
-            let value = z[k] * norm;
-            let [lo, hi] = interval(problem, x, &direction);
+    directions
+        .into_iter()
+        .zip(values.iter())
+        .map(|(f, &value)| {
+            let [lo, hi] = interval(problem, x, &f.direction);
             FreeParameter {
-                components: components.get(k).cloned().unwrap_or_default(),
+                // A component too small for the report to list does not count as a move.
+                moves_counterweights: f.variables.iter().any(|j| cw_rows.contains(j)),
+                components: f.components,
                 value,
                 interval: [value + lo, value + hi],
-                moves_counterweights: cw_rows
-                    .iter()
-                    .any(|&r| (col[r] * scale[r]).abs() > 1e-9 * (col[big] * scale[big]).abs()),
             }
         })
         .collect()
@@ -1111,11 +1114,11 @@ fn record(
         out.reason = Some(why.join("; "));
     } else {
         out.status = OptimisedStatus::Feasible;
-        if run.state == State::Stopped {
-            out.reason = None;
-        }
     }
     out.verification = Some(report);
     out.indicators = Some(ind);
     out
 }
+
+#[cfg(test)]
+mod tests;
