@@ -403,3 +403,34 @@ fn free_parameter_intervals_match_the_bounds_by_hand() {
     // spring coordinates)
     assert_eq!(checked, 4);
 }
+
+/// Two ways the pass recovers when the spring realization finds nothing at the motors' best
+/// counterweights, each turning a variant that would otherwise be undecided into a verified
+/// one:
+/// - `{K72, K75}` with one spring start per pass: the first start finds no admissible springs,
+///   the pass retries with four times as many starts and finds them;
+/// - `{m4, K72}` (default starts): no admissible K72 exists for the motors' best m4 even from
+///   32 starts, so the counterweight moves together with the spring (the joint search).
+#[test]
+fn the_spring_realization_recovers_by_more_starts_and_by_moving_the_counterweights() {
+    let json = common::case_json("palletizer.json");
+    let model = common::model(&json);
+    let one_start = OptimiseOptions {
+        spring_starts: 1,
+        ..OptimiseOptions::default()
+    };
+    let (_, retried) = common::optimise(&model, &[&["K72", "K75"]], &one_start);
+    let (_, joint) = common::optimise(&model, &[&["m4", "K72"]], &OptimiseOptions::default());
+    for v in retried.iter().chain(&joint) {
+        assert_eq!(
+            v.status,
+            OptimisedStatus::Feasible,
+            "{:?}: {:?}",
+            v.elements,
+            v.reason
+        );
+        assert!(v.verification.as_ref().unwrap().passed);
+        assert!(!v.springs.is_empty() && v.springs.iter().all(|s| s.stiffness > 0.0));
+    }
+    assert_eq!((retried.len(), joint.len()), (1, 1));
+}

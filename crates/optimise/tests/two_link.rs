@@ -243,3 +243,70 @@ fn minimax_with_two_actuators_matches_a_qtr_scan() {
     let at_rms = scan(&model, m_rms, m_rms, 1, qtr)[0].1;
     assert!(at_rms >= q_star * (1.0 - 1e-9), "{at_rms} vs {q_star}");
 }
+
+/// A relaxation that clarabel cannot finish (three iterations allowed; it needs eight) proves
+/// nothing: no lower bound is reported and the gap before refinement is unknown, but the local
+/// search from the relaxation's last iterate, the bounds-only point and the particular solution
+/// still reaches the optimum of the fine scan.
+#[test]
+fn an_unsolved_relaxation_still_reaches_the_optimum_without_a_bound() {
+    let json = case([0.5, 40.0], None);
+    let model = common::model(&json);
+    let options = OptimiseOptions {
+        solver_iterations: 3,
+        ..OptimiseOptions::default()
+    };
+    let (_, results) = common::optimise(&model, &[&["m1", "m2"]], &options);
+    let v = &results[0];
+    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.lower_bound, None);
+    assert_eq!(v.gap, None);
+    for it in &v.iterations {
+        assert_ne!(
+            it.relaxation_status,
+            counterpoise_optimise::ConicStatus::Solved
+        );
+        assert_eq!(it.lower_bound, 0.0);
+        assert_eq!(it.gap_before_refinement, f64::INFINITY);
+    }
+    let lo = 0.5_f64.max((M2 * C2 + TOOL * L2) / 2.0);
+    let (_, f_star) = fine_scan(&model, lo, 40.0, None, rms_star);
+    let obj = v.objective.unwrap();
+    assert!(
+        (obj - f_star).abs() <= 1e-4 * f_star,
+        "objective {obj} vs scan {f_star}"
+    );
+}
+
+/// Bounds no point meets: m2·r2 is fixed at −(M2 c2 + m_tool L2) = −1.35 kg·m, so a radius of
+/// at most 2 m needs m2 ≥ 0.675 kg, above the allowed [0.1, 0.5] kg. A solved relaxation proves
+/// it (discarded, the mass bound named); with one solver iteration nothing is proved, and the
+/// variant is undecided after all three starting points fail.
+#[test]
+fn infeasibility_is_discarded_only_when_proved() {
+    let json = case([0.1, 0.5], None);
+    let model = common::model(&json);
+    let (_, proved) = common::optimise(&model, &[&["m1", "m2"]], &OptimiseOptions::default());
+    assert_eq!(
+        proved[0].status,
+        OptimisedStatus::Discarded,
+        "{:?}",
+        proved[0].reason
+    );
+    let options = OptimiseOptions {
+        solver_iterations: 1,
+        ..OptimiseOptions::default()
+    };
+    let (_, unproved) = common::optimise(&model, &[&["m1", "m2"]], &options);
+    let v = &unproved[0];
+    assert_eq!(v.status, OptimisedStatus::Undecided, "{:?}", v.reason);
+    let reason = v.reason.as_deref().unwrap();
+    assert!(
+        reason.starts_with("no parameters meeting every bound were found from 3 starting points"),
+        "{reason}"
+    );
+    assert!(
+        reason.contains("the convex relaxation could not be solved either (clarabel: "),
+        "{reason}"
+    );
+}
