@@ -1084,3 +1084,62 @@ fn operator_tile<const R: usize, const W: usize>(
         out[(r0 + r) * ld + c0..(r0 + r) * ld + c0 + W].copy_from_slice(a);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::params::{ParameterSet, Variant};
+    use crate::runner::{Evaluator, Workspace};
+    use counterpoise_model::Case;
+
+    /// The palletizer's closed loops overconstrain its joints: the reactions are the
+    /// minimum-norm solution. The fast path gets it from a Cholesky factor of `A Aᵀ + U Uᵀ`; the
+    /// fallback (used when that factorisation is not safe) from the SVD pseudo-inverse of `A`.
+    /// Forced onto the fallback, the same move gives the same reactions.
+    #[test]
+    fn the_pseudo_inverse_fallback_gives_the_fast_path_minimum_norm_reactions() {
+        let path = format!("{}/../../cases/palletizer.json", env!("CARGO_MANIFEST_DIR"));
+        let model = Case::from_path(std::path::Path::new(&path)).unwrap();
+        let fast = Evaluator::new(&model).unwrap();
+        assert!(fast.reactions.fast && fast.reactions.minimum_norm);
+        let mut fallback = Evaluator::new(&model).unwrap();
+        fallback.reactions.fast = false;
+        let params = ParameterSet::from_variants(&model, &[Variant::default()]).unwrap();
+        let tasks = model.tasks.as_ref().unwrap();
+        let (from, to): (Vec<f64>, Vec<f64>) =
+            tasks.grid.iter().map(|axis| (axis.from, axis.to)).unzip();
+        let reactions = |ev: &Evaluator| {
+            let mut q = ev.solve_point(&from).unwrap();
+            let mut out = Vec::new();
+            ev.run_move(
+                &from,
+                &to,
+                tasks.duration,
+                11,
+                &mut q,
+                &params,
+                &[0],
+                true,
+                &mut Workspace::default(),
+                |_, view| out.push(view.reactions[0].clone()),
+            )
+            .unwrap();
+            out
+        };
+        let (a, b) = (reactions(&fast), reactions(&fallback));
+        assert_eq!(a.len(), 11);
+        let scale = a
+            .iter()
+            .flat_map(|r| r.force.iter().chain(&r.moment))
+            .fold(0.0f64, |m, v| m.max(v.amax()));
+        for (ra, rb) in a.iter().zip(&b) {
+            for (x, y) in ra
+                .force
+                .iter()
+                .zip(&rb.force)
+                .chain(ra.moment.iter().zip(&rb.moment))
+            {
+                assert!((x - y).amax() <= 1e-9 * scale, "{x} vs {y}");
+            }
+        }
+    }
+}

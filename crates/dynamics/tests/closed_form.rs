@@ -3,7 +3,10 @@
 mod common;
 
 use common::{assert_close, case, quintic};
-use counterpoise_dynamics::{Counterweight, ParameterSet, Variant, task_series, task_series_with};
+use counterpoise_dynamics::runner::Workspace;
+use counterpoise_dynamics::{
+    Counterweight, Evaluator, ParameterSet, Variant, task_series, task_series_with,
+};
 
 const G: f64 = 9.81;
 
@@ -259,4 +262,104 @@ fn cylinder_counterweight_with_tau_not_one() {
             "balanced torque with a τ = 0.5 cylinder",
         );
     }
+}
+
+/// The pendulum on a tilted axis, driven through the coordinate `u = 2θ`: the rod turns by
+/// φ = 2θ = u about `u_J = R·z = (0.48, −0.6, 0.64)`, `R = R_y(atan2(3, 4)) R_x(atan2(3, 4))`,
+/// so both perpendiculars of the joint axis mix the world axes, and the chart coordinate θ is
+/// not the actuated one (the grid moves u from −1.5 to 1.5). By hand, with the rod's COM at
+/// `p = R R_z(φ) c`
+/// (c = L/2 along x) and its inertia about the pivot diagonal with the rotation axis a
+/// principal axis (`L_O = J φ̇ u_J`, `J = I_zz + m c²`):
+/// - pivot force `F = m (a − g)`, `a = φ̈ u_J × p + φ̇² u_J × (u_J × p)`;
+/// - moment `dL_O/dt − p × m g = J φ̈ u_J − p × m g`: the actuator takes the part along
+///   `u_J`, the joint the rest, `|(p × m g)_⊥|`;
+/// - actuator force on u: `J φ̈ − u_J·(p × m g)` (δu = δφ), and θ = u/2.
+#[test]
+fn tilted_pendulum_driven_through_a_scaled_coordinate() {
+    let text = std::fs::read_to_string(format!(
+        "{}/../../cases/pendulum.json",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    json["bodies"][0]["pose"] = serde_json::json!([{ "rot_y": "atan2(3, 4)" }, { "rot_x": "atan2(3, 4)" }, { "rot_z": "2*th" }]);
+    json["joints"][0]["axis"] = serde_json::json!([0.48, -0.6, 0.64]);
+    json["actuators"][0]["coordinate"] = serde_json::json!("2*th");
+    let model = common::case_from_text(&json.to_string());
+    let (m, c, izz) = (2.0, 0.5, 0.1667);
+    let j = izz + m * c * c;
+    // R = R_y(β) R_x(α) with sin = 3/5, cos = 4/5 for both.
+    let (sn, cs) = (0.6, 0.8);
+    let rotation = [
+        [cs, sn * sn, sn * cs],
+        [0.0, cs, -sn],
+        [-sn, cs * sn, cs * cs],
+    ];
+    let rotate = |v: [f64; 3]| -> [f64; 3] {
+        std::array::from_fn(|r| (0..3).map(|k| rotation[r][k] * v[k]).sum())
+    };
+    let u = rotate([0.0, 0.0, 1.0]);
+    assert_eq!(u.map(|v| (v * 100.0).round() / 100.0), [0.48, -0.6, 0.64]);
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let weight = [0.0, -m * G, 0.0];
+    // The reactions as vectors (world axes): the force and moment the base exerts on the rod.
+    let ev = Evaluator::new(&model).unwrap();
+    let params = ParameterSet::from_variants(&model, &[Variant::default()]).unwrap();
+    let mut q = ev.solve_point(&[-1.5]).unwrap();
+    let mut samples = 0;
+    let mut largest_x_moment = 0.0f64;
+    ev.run_move(
+        &[-1.5],
+        &[1.5],
+        1.0,
+        41,
+        &mut q,
+        &params,
+        &[0],
+        true,
+        &mut Workspace::default(),
+        |_, view| {
+            samples += 1;
+            let (phi, phid, phidd) = quintic(-1.5, 1.5, 1.0, view.t);
+            assert_close(view.q[0], phi / 2.0, 1e-10, "theta");
+            let p = rotate([c * phi.cos(), c * phi.sin(), 0.0]);
+            let u_p = cross(u, p);
+            let u_u_p = cross(u, u_p);
+            let gravity_moment = cross(p, weight);
+            let along = dot(u, gravity_moment);
+            let reaction = &view.reactions[0];
+            for r in 0..3 {
+                let a = phidd * u_p[r] + phid * phid * u_u_p[r];
+                let force = m * a - weight[r];
+                assert_close(reaction.force[0][r], force, 1e-9 * (1.0 + force.abs()), "F");
+                let moment = -(gravity_moment[r] - along * u[r]);
+                assert_close(
+                    reaction.moment[0][r],
+                    moment,
+                    1e-9 * (1.0 + moment.abs()),
+                    "M",
+                );
+            }
+            largest_x_moment = f64::max(largest_x_moment, (gravity_moment[0] - along * u[0]).abs());
+            let tau = j * phidd - along;
+            assert_close(
+                view.actuator_force[0][0],
+                tau,
+                1e-9 * (1.0 + tau.abs()),
+                "actuator force",
+            );
+        },
+    )
+    .unwrap();
+    assert_eq!(samples, 41);
+    // the moment across the axis has components on all three world axes
+    assert!(largest_x_moment > 0.1, "{largest_x_moment}");
 }
