@@ -467,7 +467,9 @@ fn step(
         false,
         None,
     );
-    if springs.is_empty() && !problem.springs.is_empty() {
+    // Nothing found means the variant has springs (without any, the realization returns the
+    // point itself): retry with more starts.
+    if springs.is_empty() {
         (springs, note, starts_record) = realize_springs_reusing(
             problem,
             &ctx.basis.unbalanced,
