@@ -317,3 +317,40 @@ fn the_spring_choice_keeps_the_lowest_delta_r_of_all_options() {
         "{best_positions:?}"
     );
 }
+
+/// The products `K·a_i·b_j` of a spring's lifted variables enter no convex bound (only `K`,
+/// `K·a` and `K·b` do), so along one of them the bounds hold without end both ways; along `K`
+/// the interval ends at the case's stiffness bounds, [1000, 10000] N/m, by hand.
+#[test]
+fn an_interval_is_unbounded_along_what_no_bound_constrains() {
+    let json = case_json("palletizer.json");
+    let model = model(&json);
+    let ctx = Context::new(&model, None).unwrap();
+    let run = run_after_loop(
+        &ctx,
+        &balanced_variant(&model, &["m3", "K43"]),
+        &OptimiseOptions::default(),
+    );
+    let problem = run.problem.as_ref().unwrap();
+    let x = &run.candidate.as_ref().unwrap().x;
+    let names: Vec<String> = problem
+        .set
+        .iter()
+        .flat_map(|&e| ctx.catalogue.entries[e].variables.clone())
+        .collect();
+    let along = |name: &str| {
+        let mut d = DVector::zeros(names.len());
+        d[names.iter().position(|n| n == name).unwrap()] = 1.0;
+        d
+    };
+    assert_eq!(
+        interval(problem, x, &along("K43·ax·by")),
+        [f64::NEG_INFINITY, f64::INFINITY]
+    );
+    let k = x[names.iter().position(|n| n == "K43").unwrap()];
+    let [lo, hi] = interval(problem, x, &along("K43"));
+    // K also bounds |K·a| ≤ a_hi·K and |K·b| ≤ b_hi·K from below: the lower end is the larger
+    // of 1000 N/m and what those need.
+    assert!((k + hi - 10000.0).abs() <= 1e-6, "{}", k + hi);
+    assert!(k + lo >= 1000.0 - 1e-6 && lo < 0.0, "{}", k + lo);
+}
