@@ -119,6 +119,30 @@ fn free_parameters_rebuild_the_point_and_end_on_a_bound() {
         "{:?}",
         free.iter().map(|fp| &fp.components).collect::<Vec<_>>()
     );
+    // The coupled direction moves m1·r1x by −L1 per kg of m2 (by hand, from the balance
+    // relation), and each direction is normalised as the balance crate reports it: its largest
+    // column-scaled component is ±1.
+    let coupled = free.iter().find(|fp| fp.components.len() == 2).unwrap();
+    let component = |name: &str| {
+        coupled
+            .components
+            .iter()
+            .find(|(n, _)| n == name)
+            .unwrap_or_else(|| panic!("{name} not in {:?}", coupled.components))
+            .1
+    };
+    assert!((component("m1·r1x") / component("m2") + 0.8).abs() <= 1e-12);
+    for fp in &free {
+        let (_, largest) = fp
+            .components
+            .iter()
+            .map(|(name, c)| {
+                let j = names.iter().position(|n| n == name).unwrap();
+                ((c * problem.solution.column_scale[j]).abs(), *c)
+            })
+            .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+        assert_eq!(largest.abs(), 1.0, "{:?}", fp.components);
+    }
     let mut rebuilt = problem.solution.particular.clone();
     for fp in &free {
         rebuilt += direction_of(fp) * fp.value;
