@@ -566,6 +566,26 @@ fn dynamics_variant(problem: &VariantProblem, c: &Candidate) -> Variant {
     }
 }
 
+/// The dynamics variant of a candidate's counterweights with other springs.
+fn with_springs(problem: &VariantProblem, cand: &Candidate, springs: &[SpringValues]) -> Variant {
+    dynamics_variant(
+        problem,
+        &Candidate {
+            springs: springs.to_vec(),
+            ..cand.clone()
+        },
+    )
+}
+
+/// The names of the set's lifted variables, in the order of the problem's columns.
+fn lifted_names(ctx: &Context, problem: &VariantProblem) -> Vec<String> {
+    problem
+        .set
+        .iter()
+        .flat_map(|&e| ctx.catalogue.entries[e].variables.clone())
+        .collect()
+}
+
 /// The all-task indicators of each variant.
 ///
 /// The dynamics crate evaluates a batch through the cyclic shortcut only when no variant of it
@@ -947,15 +967,7 @@ fn spring_choice(
     }
     let variants: Vec<Variant> = options_found
         .iter()
-        .map(|(s, _)| {
-            dynamics_variant(
-                problem,
-                &Candidate {
-                    springs: s.clone(),
-                    ..cand.clone()
-                },
-            )
-        })
+        .map(|(s, _)| with_springs(problem, cand, s))
         .collect();
     let tasks: Vec<usize> = joint_tasks
         .iter()
@@ -1050,12 +1062,7 @@ fn record(
             anchor_b: s.anchor_b,
         })
         .collect();
-    let names: Vec<String> = problem
-        .set
-        .iter()
-        .flat_map(|&e| ctx.catalogue.entries[e].variables.clone())
-        .collect();
-    out.free_parameters = free_parameters(problem, &names, &cand.x);
+    out.free_parameters = free_parameters(problem, &lifted_names(ctx, problem), &cand.x);
     out.lower_bound = cand.bound_certified.then_some(cand.lower_bound);
     let ind = match indicators {
         Some(Ok(i)) => i,

@@ -100,11 +100,7 @@ fn free_parameters_rebuild_the_point_and_end_on_a_bound() {
     let run = run_after_loop(&ctx, &variant, &OptimiseOptions::default());
     let problem = run.problem.as_ref().unwrap();
     let x = &run.candidate.as_ref().unwrap().x;
-    let names: Vec<String> = problem
-        .set
-        .iter()
-        .flat_map(|&e| ctx.catalogue.entries[e].variables.clone())
-        .collect();
+    let names = lifted_names(&ctx, problem);
     let free = free_parameters(problem, &names, x);
     assert_eq!(free.len(), 2);
     let direction_of = |fp: &FreeParameter| {
@@ -294,15 +290,7 @@ fn the_spring_choice_keeps_the_lowest_delta_r_of_all_options() {
         );
         let variants: Vec<Variant> = found
             .iter()
-            .map(|(s, _)| {
-                dynamics_variant(
-                    problem,
-                    &Candidate {
-                        springs: s.clone(),
-                        ..cand.clone()
-                    },
-                )
-            })
+            .map(|(s, _)| with_springs(problem, cand, s))
             .collect();
         let params = ParameterSet::from_variants(&ctx.model, &variants).unwrap();
         let grid = evaluate_grid(&ctx.model, &params, &EvaluateOptions::default()).unwrap();
@@ -357,11 +345,7 @@ fn an_interval_is_unbounded_along_what_no_bound_constrains() {
     );
     let problem = run.problem.as_ref().unwrap();
     let x = &run.candidate.as_ref().unwrap().x;
-    let names: Vec<String> = problem
-        .set
-        .iter()
-        .flat_map(|&e| ctx.catalogue.entries[e].variables.clone())
-        .collect();
+    let names = lifted_names(&ctx, problem);
     let along = |name: &str| {
         let mut d = DVector::zeros(names.len());
         d[names.iter().position(|n| n == name).unwrap()] = 1.0;
