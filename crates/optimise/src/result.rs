@@ -62,8 +62,10 @@ pub struct FreeParameter {
     pub components: Vec<(String, f64)>,
     pub value: f64,
     pub interval: [f64; 2],
-    /// Whether this coordinate changes a counterweight (otherwise only springs: motor torques
-    /// do not depend on it).
+    /// Whether a counterweight variable is among `components`, i.e. this coordinate changes a
+    /// counterweight; otherwise it changes only springs, on which the motor torques do not
+    /// depend. (`components` omits the negligible ones: below 1e-4 of the largest, in the
+    /// balance matrix's column-scaled units.)
     pub moves_counterweights: bool,
 }
 
