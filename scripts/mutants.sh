@@ -5,7 +5,7 @@
 #
 #   scripts/mutants.sh [FILE…] [-- CARGO-MUTANTS-ARGS…]
 #       mutate FILEs (default: the files whose logic decides results, listed below)
-#   scripts/mutants.sh --diff [BASE]
+#   scripts/mutants.sh --diff [BASE] [-- CARGO-MUTANTS-ARGS…]
 #       mutate only the lines changed since BASE (default: main), for a change under review
 #
 # Each mutant rebuilds the mutated crate and runs its package's tests: tens of seconds each on
@@ -25,10 +25,16 @@ out=target/mutants
 mkdir -p "$out"
 
 if [[ "${1:-}" == "--diff" ]]; then
-    base="${2:-main}"
+    base="main"
+    shift
+    if [[ $# -gt 0 && "$1" != "--" ]]; then
+        base="$1"
+        shift
+    fi
+    [[ "${1:-}" == "--" ]] && shift
     diff_file="$out/change.diff"
     git diff "$base" -- '*.rs' >"$diff_file"
-    exec cargo mutants --workspace --in-diff "$diff_file" -o "$out"
+    exec cargo mutants --workspace --in-diff "$diff_file" -o "$out" "$@"
 fi
 
 files=()
