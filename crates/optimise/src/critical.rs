@@ -69,6 +69,7 @@ impl Default for OptimiseOptions {
 }
 
 /// A variant in the loop.
+#[derive(Clone)]
 struct Run {
     elements: Vec<String>,
     class: counterpoise_balance::Class,

@@ -172,6 +172,7 @@ fn the_final_checks_decide_the_verdict() {
     let options = OptimiseOptions::default();
     let run = run_after_loop(&ctx, &variant, &options);
     assert_eq!(run.state, State::Converged);
+    assert_eq!(run.problem.as_ref().unwrap().counterweights[0].label, "m1");
     let final_indicators = |run: &Run| {
         grid_indicators(
             &ctx,
@@ -186,14 +187,14 @@ fn the_final_checks_decide_the_verdict() {
     let verdict =
         |run: Run, ind: &Indicators| record(&ctx, run, None, Some(Ok(ind.clone())), &options);
 
-    let feasible = verdict(clone_run(&run), &ind);
+    let feasible = verdict(run.clone(), &ind);
     assert_eq!(feasible.status, OptimisedStatus::Feasible);
     assert_eq!(feasible.reason, None);
     assert!(feasible.residual.unwrap() <= 1e-9);
 
     // M1's limit equals its peak (met); M2's is 10 % under its peak (violated).
     let (peak1, peak2) = (ind.actuators[0].cpt_peak, ind.actuators[1].cpt_peak);
-    let mut limited = clone_run(&run);
+    let mut limited = run.clone();
     limited.problem.as_mut().unwrap().peak_limits = vec![Some(peak1), Some(0.9 * peak2)];
     let over = verdict(limited, &ind);
     assert_eq!(over.status, OptimisedStatus::Discarded);
@@ -212,7 +213,7 @@ fn the_final_checks_decide_the_verdict() {
     );
 
     // m1 moved off its first moment by 1 %: the balance fails.
-    let mut unbalanced = clone_run(&run);
+    let mut unbalanced = run.clone();
     let cand = unbalanced.candidate.as_mut().unwrap();
     cand.cws[0].mu = cand.cws[0].mu.map(|v| v * 1.01);
     let ind_unbalanced = final_indicators(&unbalanced);
@@ -227,7 +228,7 @@ fn the_final_checks_decide_the_verdict() {
 
     // m1 at 30 kg with the same first moment: still balanced (link 1 turns about the fixed
     // joint J1, so only m1·r1 enters its potential energy), but over the 20 kg bound.
-    let mut heavy = clone_run(&run);
+    let mut heavy = run.clone();
     let cand = heavy.candidate.as_mut().unwrap();
     cand.cws[0].mass = 30.0;
     let ind_heavy = final_indicators(&heavy);
@@ -240,23 +241,11 @@ fn the_final_checks_decide_the_verdict() {
     );
     assert!(over_bound.residual.unwrap() <= 1e-9);
 
-    let mut undecided = clone_run(&run);
+    let mut undecided = run.clone();
     undecided.state = State::Undecided("the kinematics failed".into());
     let kept = verdict(undecided, &ind);
     assert_eq!(kept.status, OptimisedStatus::Undecided);
     assert_eq!(kept.reason.as_deref(), Some("the kinematics failed"));
-}
-
-fn clone_run(run: &Run) -> Run {
-    Run {
-        elements: run.elements.clone(),
-        class: run.class,
-        problem: run.problem.clone(),
-        working: run.working.clone(),
-        iterations: run.iterations.clone(),
-        state: run.state.clone(),
-        candidate: run.candidate.clone(),
-    }
 }
 
 /// The spring choice keeps, of the admissible spring sets found from four times the pass's
