@@ -6,7 +6,7 @@ mod common;
 use common::{case_from_text, coarse_palletizer};
 use counterpoise_dynamics::{
     Counterweight, EvaluateOptions, ParameterSet, Spring, Variant, evaluate, evaluate_grid,
-    task_series,
+    task_series, task_series_with,
 };
 use counterpoise_model::{GridAxis, Model};
 
@@ -347,4 +347,48 @@ fn cyclic_shortcut_matches_direct_evaluation() {
             assert!(close(fj.force, dj.force) && close(fj.moment, dj.moment));
         }
     }
+}
+
+/// Two paths to the joint reactions agree on every task: the grid evaluation (one reaction
+/// operator per sample applied to every column, buffers reused from sample to sample) and the
+/// per-task series (each sample solved by substitution into fresh buffers). A spring to the
+/// base rules out the cyclic shortcut, so θ1 itself is sampled, including θ1 = 0, where the
+/// second joint's axis is a world axis and its moment basis writes fewer output rows.
+#[test]
+fn grid_reaction_peaks_match_the_per_task_series() {
+    let model = coarse_palletizer();
+    let variant = Variant {
+        counterweights: vec![],
+        springs: vec![Spring {
+            body: 3,
+            other: None,
+            stiffness: 5000.0,
+            anchor: [0.5, 0.0, 0.0],
+            other_anchor: [0.0, 0.0, 0.5],
+        }],
+    };
+    let params = ParameterSet::from_variants(&model, &[variant]).unwrap();
+    let grid = evaluate_grid(&model, &params, &EvaluateOptions::default()).unwrap();
+    assert_eq!(grid.cyclic_coordinate, None);
+    assert_eq!(grid.excluded.count, 0);
+    let mut compared = 0;
+    for w in 0..grid.tasks.len() {
+        let (i, j) = grid.tasks.pair(w);
+        let stats = grid.stats(w, 0).unwrap();
+        let series = task_series_with(&model, &params, 0, i, j, Some(11)).unwrap();
+        for (n, joint) in series.joints.iter().enumerate() {
+            let force = joint.force.iter().copied().fold(0.0, f64::max);
+            let moment = joint.moment.iter().copied().fold(0.0, f64::max);
+            for (grid_peak, series_peak) in
+                [(stats.force_peak[n], force), (stats.moment_peak[n], moment)]
+            {
+                assert!(
+                    (grid_peak - series_peak).abs() <= 1e-9 * series_peak.max(1.0),
+                    "task {i}→{j}, joint {n}: {grid_peak} vs {series_peak}"
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert_eq!(compared, 351 * 2 * model.joints.len());
 }
