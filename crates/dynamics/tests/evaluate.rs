@@ -352,8 +352,7 @@ fn cyclic_shortcut_matches_direct_evaluation() {
 /// Two paths to the joint reactions agree on every task: the grid evaluation (one reaction
 /// operator per sample applied to every column, buffers reused from sample to sample) and the
 /// per-task series (each sample solved by substitution into fresh buffers). A spring to the
-/// base rules out the cyclic shortcut, so θ1 itself is sampled, including θ1 = 0, where the
-/// second joint's axis is a world axis and its moment basis writes fewer output rows.
+/// base rules out the cyclic shortcut, so θ1 itself is sampled.
 #[test]
 fn grid_reaction_peaks_match_the_per_task_series() {
     let model = coarse_palletizer();
