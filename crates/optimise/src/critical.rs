@@ -530,28 +530,35 @@ fn step(
 fn candidate_variants(runs: &[Run], ks: &[usize]) -> Vec<Variant> {
     ks.iter()
         .map(|&k| {
+            let cand = runs[k].candidate.as_ref().expect("candidate");
             dynamics_variant(
                 runs[k].problem.as_ref().expect("problem"),
-                runs[k].candidate.as_ref().expect("candidate"),
+                &cand.cws,
+                &cand.springs,
             )
         })
         .collect()
 }
 
-fn dynamics_variant(problem: &VariantProblem, c: &Candidate) -> Variant {
+/// The dynamics crate's variant of physical counterweights `cws` (in the problem's slot order)
+/// and realized springs.
+fn dynamics_variant(
+    problem: &VariantProblem,
+    cws: &[CwPhysical],
+    springs: &[SpringValues],
+) -> Variant {
     Variant {
         counterweights: problem
             .counterweights
             .iter()
-            .zip(&c.cws)
+            .zip(cws)
             .map(|(slot, p)| Counterweight {
                 body: slot.body,
                 mass: p.mass,
                 position: p.offset(),
             })
             .collect(),
-        springs: c
-            .springs
+        springs: springs
             .iter()
             .map(|s| Spring {
                 body: s.body,
@@ -565,17 +572,6 @@ fn dynamics_variant(problem: &VariantProblem, c: &Candidate) -> Variant {
             })
             .collect(),
     }
-}
-
-/// The dynamics variant of a candidate's counterweights with other springs.
-fn with_springs(problem: &VariantProblem, cand: &Candidate, springs: &[SpringValues]) -> Variant {
-    dynamics_variant(
-        problem,
-        &Candidate {
-            springs: springs.to_vec(),
-            ..cand.clone()
-        },
-    )
 }
 
 /// The names of the set's lifted variables, in the order of the problem's columns.
@@ -968,7 +964,7 @@ fn spring_choice(
     }
     let variants: Vec<Variant> = options_found
         .iter()
-        .map(|(s, _)| with_springs(problem, cand, s))
+        .map(|(s, _)| dynamics_variant(problem, &cand.cws, s))
         .collect();
     let tasks: Vec<usize> = joint_tasks
         .iter()

@@ -279,7 +279,7 @@ fn the_spring_choice_keeps_the_lowest_delta_r_of_all_options() {
         );
         let variants: Vec<Variant> = found
             .iter()
-            .map(|(s, _)| with_springs(problem, cand, s))
+            .map(|(s, _)| dynamics_variant(problem, &cand.cws, s))
             .collect();
         let params = ParameterSet::from_variants(&ctx.model, &variants).unwrap();
         let grid = evaluate_grid(&ctx.model, &params, &EvaluateOptions::default()).unwrap();
