@@ -108,6 +108,18 @@ enum Command {
         /// DIR/shard-I-of-N.json for `merge` instead of the reports.
         #[arg(long, value_name = "I/N", value_parser = parse_shard)]
         shard: Option<counterpoise::shard::ShardSpec>,
+        /// Relative optimality gap at which the certified search stops: every feasible
+        /// variant's objective is within it of the certified lower bound.
+        #[arg(long, default_value_t = 1e-3, value_name = "REL", value_parser = parse_gap)]
+        gap: f64,
+        /// Boxes the certified search may solve per variant and pass; a variant that reaches
+        /// the limit before a verdict ends undecided, and says so.
+        #[arg(long, default_value_t = 2000, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+        max_nodes: u64,
+        /// Seed of the local search's starting points (verdicts, optima and ranks do not
+        /// depend on it).
+        #[arg(long, value_name = "N")]
+        seed: Option<u64>,
         #[command(flatten)]
         jobs: Jobs,
     },
@@ -254,6 +266,9 @@ fn run(cli: Cli) -> ExitCode {
             tolerance,
             quiet,
             shard,
+            gap,
+            max_nodes,
+            seed,
             ..
         } => commands::run::run(
             &case,
@@ -270,6 +285,11 @@ fn run(cli: Cli) -> ExitCode {
                     if shard.is_some() { 3 } else { 4 },
                 ),
                 shard,
+                search: commands::run::SearchSettings {
+                    gap,
+                    max_nodes: max_nodes as usize,
+                    seed,
+                },
             },
         ),
         Command::Merge {
@@ -325,6 +345,15 @@ fn parse_shard(text: &str) -> Result<counterpoise::shard::ShardSpec, String> {
 }
 
 /// Percentage points: a finite number ≥ 0.
+fn parse_gap(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 && x < 1.0 => Ok(x),
+        _ => Err(format!(
+            "`{text}` is not a relative gap (a number greater than 0 and less than 1, e.g. 1e-3)"
+        )),
+    }
+}
+
 fn parse_points(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),

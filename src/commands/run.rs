@@ -44,6 +44,30 @@ pub struct Options {
     pub progress: super::progress::Progress,
     /// Optimise only this shard's variants and write a partial result.
     pub shard: Option<ShardSpec>,
+    /// The certified search's settings.
+    pub search: SearchSettings,
+}
+
+/// Settings of the certified spring stage (`--gap`, `--max-nodes`, `--seed`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SearchSettings {
+    /// Relative optimality gap at which the search stops.
+    pub gap: f64,
+    /// Boxes per variant and pass.
+    pub max_nodes: usize,
+    /// Seed of the local search's starts (`None`: the built-in one).
+    pub seed: Option<u64>,
+}
+
+impl Default for SearchSettings {
+    fn default() -> Self {
+        let d = OptimiseOptions::default();
+        SearchSettings {
+            gap: d.gap_tolerance,
+            max_nodes: d.max_nodes,
+            seed: None,
+        }
+    }
 }
 
 /// Times the phases and shows their progress.
@@ -128,14 +152,7 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
         "Phase 2: optimisation of the {} balanced variants",
         balanced.len()
     );
-    let optimised = optimise(
-        &model,
-        &front,
-        &balanced,
-        options.minimax,
-        &mut timer,
-        &phase,
-    )?;
+    let optimised = optimise(&model, &front, &balanced, &options, &mut timer, &phase)?;
     let study = Study {
         model: &model,
         case_path: path.display().to_string(),
@@ -240,7 +257,7 @@ fn optimise(
     model: &Model,
     front: &Front,
     ids: &[usize],
-    minimax: bool,
+    options: &Options,
     timer: &mut Timer,
     phase: &str,
 ) -> Result<Vec<OptimisedRecord>> {
@@ -250,9 +267,13 @@ fn optimise(
         .collect();
     timer.time_reporting(phase, |phase| {
         let context = Context::new(model, Some(front.unbalanced.clone()))?;
+        let defaults = OptimiseOptions::default();
         let settings = OptimiseOptions {
-            objective: objective(minimax),
-            ..OptimiseOptions::default()
+            objective: objective(options.minimax),
+            gap_tolerance: options.search.gap,
+            max_nodes: options.search.max_nodes,
+            start_seed: options.search.seed.unwrap_or(defaults.start_seed),
+            ..defaults
         };
         let report = |p: counterpoise_optimise::StageProgress| {
             let stage = if p.stage == "critical-task pass" {
@@ -304,7 +325,7 @@ fn run_shard(
         ids.len(),
         balanced.len()
     );
-    let optimised = optimise(model, front, &ids, options.minimax, &mut timer, &phase)?;
+    let optimised = optimise(model, front, &ids, options, &mut timer, &phase)?;
     let case_text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     let file = ShardFile {
@@ -565,6 +586,7 @@ fn record(
         lower_bound: opt.lower_bound,
         gap: opt.gap,
         iterations: Some(opt.iterations),
+        boxes: Some(opt.boxes),
         message: opt.reason.clone(),
     });
     let balancing = model.balancing.as_ref();

@@ -179,6 +179,9 @@ pub struct OptimisedRecord {
     pub residual: Option<f64>,
     /// Passes of the critical-task loop.
     pub iterations: usize,
+    /// Boxes the certified branch-and-bound solved, over all passes.
+    #[serde(default)]
+    pub boxes: usize,
     pub counterweights: Vec<RecordCounterweight>,
     pub springs: Vec<RecordSpring>,
     /// Over all tasks, for the finalists.
@@ -201,6 +204,7 @@ impl OptimisedRecord {
             gap: o.gap,
             residual: o.residual,
             iterations: o.iterations.len(),
+            boxes: o.iterations.iter().map(|i| i.boxes).sum(),
             counterweights: o
                 .counterweights
                 .iter()

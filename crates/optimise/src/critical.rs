@@ -23,6 +23,7 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::certify::{BranchOptions, Design, Verdict, branch_and_bound};
 use crate::context::Context;
 use crate::problem::{CwPhysical, Objective, VariantProblem};
 use crate::progress::{ProgressSink, StageCounter};
@@ -34,7 +35,7 @@ use crate::result::{
     FreeParameter, Iteration, OptimisedCounterweight, OptimisedSpring, OptimisedStatus,
     OptimisedVariant,
 };
-use crate::springs::{SpringValues, StartRecord, realize_springs, realize_springs_reusing};
+use crate::springs::{SpringValues, StartRecord, realize_springs_reusing, realize_springs_seeded};
 use crate::timing::{StageTime, Stopwatch};
 use crate::verify::verify;
 
@@ -53,6 +54,22 @@ pub struct OptimiseOptions {
     pub final_reactions: bool,
     /// clarabel iteration limit.
     pub solver_iterations: u32,
+    /// Boxes the certified search ([`crate::certify`]) solves at most per variant and pass: the
+    /// only limit that can leave a variant undecided.
+    #[serde(default = "default_max_nodes")]
+    pub max_nodes: usize,
+    /// Seed of the local search's starting points after the first. Verdicts, optima (within
+    /// the gap tolerance) and ranks do not depend on it.
+    #[serde(default = "default_start_seed")]
+    pub start_seed: u64,
+}
+
+fn default_start_seed() -> u64 {
+    crate::springs::DEFAULT_SEED
+}
+
+fn default_max_nodes() -> usize {
+    OptimiseOptions::default().max_nodes
 }
 
 impl Default for OptimiseOptions {
@@ -64,6 +81,8 @@ impl Default for OptimiseOptions {
             spring_starts: 8,
             final_reactions: true,
             solver_iterations: 200,
+            max_nodes: 2000,
+            start_seed: crate::springs::DEFAULT_SEED,
         }
     }
 }
@@ -123,6 +142,8 @@ struct Candidate {
     /// The spring realization's local solves for these counterweights (the spring choice
     /// reuses them).
     spring_starts: Option<StartRecord>,
+    /// Boxes the certified search solved (0 when the fast path was within the tolerance).
+    boxes: usize,
 }
 
 /// Optimises one balanced variant (see [`optimise_all`]).
@@ -280,6 +301,7 @@ fn critical_task_loop(
                 relaxation_status: cand.relaxation_status,
                 relaxation_iterations: cand.relaxation_iterations,
                 gap_before_refinement: cand.gap_before,
+                boxes: cand.boxes,
             });
             if added.is_empty() {
                 run.state = State::Converged;
@@ -438,91 +460,238 @@ fn step(
         }
         smallest_violation = smallest_violation.min(refined.violation);
     }
-    let Some((z, gap_before)) = chosen else {
-        let limits = if problem.peak_limits.iter().any(Option::is_some) {
-            " and peak limit"
-        } else {
-            ""
-        };
-        let relaxation = if solved {
-            String::new()
-        } else {
-            format!(
-                "; the convex relaxation could not be solved either (clarabel: {})",
+    let fast = chosen
+        .as_ref()
+        .and_then(|(z, _)| fast_design(ctx, problem, &tasks, options, z));
+    let gap_before = chosen.as_ref().map_or(f64::INFINITY, |c| c.1);
+    if !solved {
+        // Without a certified bound the search cannot prove anything: keep what was found.
+        let Some((design, record)) = fast else {
+            let limits = if problem.peak_limits.iter().any(Option::is_some) {
+                " and peak limit"
+            } else {
+                ""
+            };
+            return Err(Failure::Undecided(format!(
+                "no parameters meeting every bound{limits} were found from {} starting points \
+                 (smallest relative violation {smallest_violation:.2e}), but none are proved \
+                 impossible; the convex relaxation could not be solved either (clarabel: {})",
+                starts.len(),
                 status.name()
-            )
+            )));
         };
-        return Err(Failure::Undecided(format!(
-            "no parameters meeting every bound{limits} were found from {} starting points \
-             (smallest relative violation {smallest_violation:.2e}), but none are proved \
-             impossible{relaxation}",
-            starts.len()
-        )));
+        return Ok(candidate(
+            design, 0.0, false, status, &relaxed, gap_before, record, 0,
+        ));
+    }
+    // The fast path's design is accepted when it is within the gap tolerance of the bound;
+    // otherwise the branch-and-bound certifies the optimum or proves that none exists.
+    if let Some((design, record)) = &fast
+        && design.value - lower <= options.gap_tolerance * design.value.abs()
+    {
+        return Ok(candidate(
+            design.clone(),
+            lower,
+            true,
+            status,
+            &relaxed,
+            gap_before,
+            record.clone(),
+            0,
+        ));
+    }
+    let (incumbent, record) = match fast {
+        Some((d, r)) => (Some(d), r),
+        None => (None, None),
     };
-    let x = problem.lifted(&z);
-    let (mut springs, mut note, mut starts_record) = realize_springs_reusing(
-        problem,
-        &ctx.basis.unbalanced,
-        &x,
-        options.spring_starts,
-        false,
-        None,
-    );
+    let branch = BranchOptions {
+        gap_tolerance: options.gap_tolerance,
+        max_nodes: options.max_nodes,
+        solver_iterations: options.solver_iterations,
+    };
+    let b = &ctx.basis.unbalanced;
+    let verdict = branch_and_bound(problem, b, &tasks, options.objective, &branch, incumbent)
+        .map_err(Failure::Undecided)?;
+    match verdict {
+        Verdict::Optimal {
+            design,
+            lower_bound,
+            nodes,
+        }
+        | Verdict::Stopped {
+            design: Some(design),
+            lower_bound,
+            nodes,
+        } => Ok(candidate(
+            design,
+            lower_bound.max(lower),
+            true,
+            status,
+            &relaxed,
+            gap_before,
+            record,
+            nodes,
+        )),
+        Verdict::Stopped {
+            design: None,
+            lower_bound,
+            nodes,
+        } => Err(Failure::Undecided(format!(
+            "the search stopped at its limit of {nodes} boxes (--max-nodes) before finding a \
+             design within the bounds or proving that none exists (lower bound {:.4} N·m)",
+            lower_bound.max(lower)
+        ))),
+        Verdict::Impossible { nodes } => Err(Failure::Discard(impossibility_certificate(
+            ctx, problem, &tasks, &branch, nodes,
+        ))),
+    }
+}
+
+/// The candidate of a pass from a design.
+fn candidate(
+    design: Design,
+    lower_bound: f64,
+    bound_certified: bool,
+    status: crate::clarabel_map::ConicStatus,
+    relaxed: &crate::relaxation::Relaxed,
+    gap_before: f64,
+    spring_starts: Option<StartRecord>,
+    boxes: usize,
+) -> Candidate {
+    Candidate {
+        boxes,
+        x: design.x,
+        cws: design.cws,
+        springs: design.springs,
+        lower_bound,
+        bound_certified,
+        working_value: design.value,
+        relaxation_status: status,
+        relaxation_iterations: relaxed.solution.iterations,
+        gap_before,
+        spring_starts,
+    }
+}
+
+/// The fast path: springs realized by local search for the refined counterweights at `z`
+/// (then with more starts, then moving the counterweights too); a design only when every
+/// bound and peak limit holds on the working set.
+fn fast_design(
+    ctx: &Context,
+    problem: &VariantProblem,
+    tasks: &[std::sync::Arc<crate::torque::TaskTorques>],
+    options: &OptimiseOptions,
+    z: &DVector<f64>,
+) -> Option<(Design, Option<StartRecord>)> {
+    let x = problem.lifted(z);
+    let b = &ctx.basis.unbalanced;
+    let seed = options.start_seed;
+    let (mut springs, _, mut starts_record) =
+        realize_springs_seeded(problem, b, &x, options.spring_starts, false, None, seed);
     // Nothing found means the variant has springs (without any, the realization returns the
     // point itself): retry with more starts.
     if springs.is_empty() {
-        (springs, note, starts_record) = realize_springs_reusing(
+        (springs, _, starts_record) = realize_springs_seeded(
             problem,
-            &ctx.basis.unbalanced,
+            b,
             &x,
             options.spring_starts * 4,
             false,
             Some(&starts_record),
+            seed,
         );
     }
-    let (springs, x_full) = match springs.into_iter().next() {
-        Some(found) => found,
-        None if !problem.counterweights.is_empty() => {
-            // The motors' best counterweights leave no admissible springs: move both.
-            let (joint, _) = realize_springs(
-                problem,
-                &ctx.basis.unbalanced,
-                &x,
-                options.spring_starts * 4,
-                true,
-            );
-            // Of the admissible sets found, the best one that meets the peak limits on the
-            // working set (or the one closest to meeting them).
-            joint
-                .into_iter()
-                .map(|(s, xj)| {
-                    let e = problem.evaluate(&problem.cw_physical(&xj), &tasks);
-                    let excess = problem.peak_excess(&e).max(0.0);
-                    let value = e.objective(options.objective, problem.actuators);
-                    (excess, value, s, xj)
-                })
-                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)))
-                .map(|(_, _, s, xj)| (s, xj))
-                .ok_or(Failure::Undecided(note))?
-        }
-        None => return Err(Failure::Undecided(note)),
+    let judge = |(s, xj): crate::springs::Realized| {
+        let cws = problem.cw_physical(&xj);
+        let e = problem.evaluate(&cws, tasks);
+        let excess = problem
+            .bound_violations(&xj)
+            .into_iter()
+            .fold(problem.peak_excess(&e), f64::max);
+        let value = e.objective(options.objective, problem.actuators);
+        (excess, value, s, xj, cws)
     };
-    let cws = problem.cw_physical(&x_full);
-    let value = problem
-        .evaluate(&cws, &tasks)
-        .objective(options.objective, problem.actuators);
-    Ok(Candidate {
-        x: x_full,
-        cws,
-        springs,
-        lower_bound: lower,
-        bound_certified: solved,
-        working_value: value,
-        relaxation_status: status,
-        relaxation_iterations: relaxed.solution.iterations,
-        gap_before,
-        spring_starts: Some(starts_record),
-    })
+    let design = |(excess, value, springs, x, cws): (f64, f64, _, _, _)| {
+        (excess <= FEASIBILITY_TOL).then_some(Design {
+            x,
+            cws,
+            springs,
+            value,
+        })
+    };
+    if let Some(found) = springs.into_iter().next() {
+        return design(judge(found)).map(|d| (d, Some(starts_record)));
+    }
+    if problem.counterweights.is_empty() {
+        return None;
+    }
+    // The motors' best counterweights leave no admissible springs: move both, and keep the
+    // best admissible set that meets the peak limits on the working set.
+    let (joint, _, _) =
+        realize_springs_seeded(problem, b, &x, options.spring_starts * 4, true, None, seed);
+    joint
+        .into_iter()
+        .map(judge)
+        .filter(|j| j.0 <= FEASIBILITY_TOL)
+        .min_by(|p, q| p.1.total_cmp(&q.1))
+        .and_then(design)
+        .map(|d| (d, Some(starts_record)))
+}
+
+/// Boxes the bounds-only search may use to word a certificate.
+const CERTIFICATE_NODES: usize = 200;
+
+/// The certificate of a variant the search proved impossible: the bounds alone when the
+/// bounds-only search also finds no box (else the peak limits on the working set), with the
+/// number of boxes.
+fn impossibility_certificate(
+    ctx: &Context,
+    problem: &VariantProblem,
+    tasks: &[std::sync::Arc<crate::torque::TaskTorques>],
+    branch: &BranchOptions,
+    nodes: usize,
+) -> String {
+    let b = &ctx.basis.unbalanced;
+    let proof = format!(
+        "proved by splitting the anchor and counterweight box into {nodes} boxes, none of \
+         which holds a solution"
+    );
+    let limited: Vec<String> = problem
+        .peak_limits
+        .iter()
+        .zip(&ctx.unbalanced.actuators)
+        .filter_map(|(l, a)| l.map(|l| format!("{} ≤ {l} N·m", a.name)))
+        .collect();
+    if limited.is_empty() || tasks.is_empty() {
+        return format!(
+            "no parameters within the bounds balance this variant ({}); {proof}",
+            crate::certify::bounds_in_words(problem)
+        );
+    }
+    // Which constraint excludes the variant: the bounds alone, when the bounds-only search
+    // proves it too (a smaller budget: this only chooses the words).
+    let wording = BranchOptions {
+        max_nodes: branch.max_nodes.min(CERTIFICATE_NODES),
+        ..*branch
+    };
+    match branch_and_bound(problem, b, &[], Objective::Minimax, &wording, None) {
+        Ok(Verdict::Impossible { nodes: n }) => format!(
+            "no parameters within the bounds balance this variant ({}); proved by splitting \
+             the anchor and counterweight box into {n} boxes, none of which holds a solution",
+            crate::certify::bounds_in_words(problem)
+        ),
+        Ok(Verdict::Optimal { .. }) => format!(
+            "parameters within the bounds exist, but none meets the peak limits ({}) on the \
+             critical tasks; {proof}",
+            limited.join(", ")
+        ),
+        _ => format!(
+            "no parameters within the bounds ({}) meet the peak limits ({}) on the critical \
+             tasks; {proof}",
+            crate::certify::bounds_in_words(problem),
+            limited.join(", ")
+        ),
+    }
 }
 
 /// The dynamics variants of the current candidates of runs `ks` (each has a problem and a

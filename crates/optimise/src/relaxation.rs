@@ -30,6 +30,7 @@ use std::sync::Arc;
 use counterpoise_dynamics::params::BODY_PARAMS;
 use nalgebra::{DMatrix, DVector};
 
+use crate::certify::node::{NodeBox, square_over_linear_planes};
 use crate::clarabel_map::{Affine, ConicProblem, ConicSolution, ConicStatus};
 use crate::problem::{Objective, VariantProblem};
 use crate::torque::TaskTorques;
@@ -158,6 +159,62 @@ pub fn solve_relaxation(
     objective: Objective,
     max_iter: u32,
 ) -> Relaxed {
+    solve_relaxation_in(problem, tasks, objective, max_iter, None)
+}
+
+/// [`solve_relaxation`] restricted to a branch-and-bound node's box (see
+/// [`crate::certify`]): every split coordinate within its interval (linear rows, exact since
+/// `K > 0` and `m > 0`), the spring couplings `W = K a⊗b` between the homogenised McCormick
+/// planes of the anchor intervals, and the counterweights' second moments and `m^{5/3}` below
+/// the planes through the box's corners. Every physical point in the box is feasible here with
+/// its true objective, so the optimum bounds the box from below; as the box shrinks to a point
+/// the rows pin the lifted point to a physical one.
+pub fn solve_relaxation_in(
+    problem: &VariantProblem,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    max_iter: u32,
+    node: Option<&NodeBox>,
+) -> Relaxed {
+    let Built {
+        mut cp,
+        peaks,
+        z,
+        dz,
+        tau_scale,
+        ..
+    } = build(problem, tasks, objective, node);
+    let d = problem.dim();
+    let solution = solve_with_lazy_peaks(&mut cp, &peaks, max_iter);
+    let zv = DVector::from_iterator(d, z.iter().zip(&dz).map(|(&j, &s)| solution.x[j] * s));
+    Relaxed {
+        bound: tau_scale
+            * solution.objective.min(solution.dual_objective)
+            * (1.0 - BOUND_MARGIN.max(10.0 * solution.tolerance)),
+        z: zv,
+        solution,
+    }
+}
+
+/// A relaxation ready to solve: the problem, its lazily added peak rows, the conic variables of
+/// the scaled free coordinates `ζ` (`z = D ζ`, `dz` the diagonal of `D`), the torque scale, and
+/// the natural magnitude of each lifted variable.
+struct Built {
+    cp: ConicProblem,
+    peaks: Vec<Affine>,
+    z: Vec<usize>,
+    dz: Vec<f64>,
+    tau_scale: f64,
+    natural: Vec<f64>,
+}
+
+/// Builds the relaxation (see [`solve_relaxation_in`]).
+fn build(
+    problem: &VariantProblem,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    node: Option<&NodeBox>,
+) -> Built {
     let mut cp = ConicProblem::default();
     let d = problem.dim();
     let natural = natural_scales(problem);
@@ -186,7 +243,7 @@ pub fn solve_relaxation(
 
     // Per counterweight: feature expressions (true units) and their torque columns.
     let mut features: Vec<Feature> = Vec::new();
-    for c in &problem.counterweights {
+    for (cw, c) in problem.counterweights.iter().enumerate() {
         let big_m = natural[c.column];
         let mn = xn(c.column);
         let n_ax = c.axes.len();
@@ -270,6 +327,51 @@ pub fn solve_relaxation(
         e.constant += mhi / big_m;
         cp.nonneg(&e);
         cp.soc(&mn.scaled(rhi * big_m / big_r), &mun);
+        let (mlo, mhi) = match node {
+            Some(nb) => {
+                let [lo, hi] = nb.mass(problem, cw);
+                let intervals: Vec<[f64; 2]> =
+                    (0..n_ax).map(|k| nb.moment(problem, cw, k)).collect();
+                within(&mut cp, &mn, [lo, hi], big_m);
+                for (k, &r) in intervals.iter().enumerate() {
+                    within(&mut cp, &mun[k], r, big_r);
+                }
+                // S_aa = μ_a²/m below the corner planes; along the diagonals likewise.
+                let below = |cp: &mut ConicProblem, s: &Affine, u: &Affine, r: [f64; 2]| {
+                    for [c0, c1, c2] in square_over_linear_planes(r, [lo, hi]) {
+                        let mut e = Affine::constant(c0 / sigma);
+                        e.add_scaled(u, c1 * big_r / sigma);
+                        e.add_scaled(&mn, c2 * big_m / sigma);
+                        e.add_scaled(s, -1.0);
+                        cp.nonneg(&e);
+                    }
+                };
+                for ka in 0..n_ax {
+                    below(&mut cp, &Affine::var(s_of(ka, ka)), &mun[ka], intervals[ka]);
+                }
+                for ka in 0..n_ax {
+                    for kb in ka + 1..n_ax {
+                        let (ia, ib) = (intervals[ka], intervals[kb]);
+                        let h = std::f64::consts::FRAC_1_SQRT_2;
+                        for sign in [1.0, -1.0] {
+                            let mut sd = Affine::var(s_of(ka, ka)).scaled(0.5);
+                            sd.add_var(s_of(kb, kb), 0.5);
+                            sd.add_var(s_of(ka, kb), sign);
+                            let mut u = mun[ka].scaled(h);
+                            u.add_scaled(&mun[kb], sign * h);
+                            let r = if sign > 0.0 {
+                                [h * (ia[0] + ib[0]), h * (ia[1] + ib[1])]
+                            } else {
+                                [h * (ia[0] - ib[1]), h * (ia[1] - ib[0])]
+                            };
+                            below(&mut cp, &sd, &u, r);
+                        }
+                    }
+                }
+                (lo, hi)
+            }
+            None => (mlo, mhi),
+        };
         // Cylinder inertia: p = P·p', P = M^{5/3}; p'^{3/5} ≥ m/M and p below the chord.
         let j_norm = c.j1.abs().max();
         if j_norm > 0.0 {
@@ -300,7 +402,7 @@ pub fn solve_relaxation(
         }
     }
     // Spring bounds (the convex ones), normalised.
-    for s in &problem.springs {
+    for (spring, s) in problem.springs.iter().enumerate() {
         let k = xn(s.column);
         let na = s.axes_a.len();
         let nb = s.axes_b.len();
@@ -319,12 +421,16 @@ pub fn solve_relaxation(
             cp.soc(&k.scaled(s.bounds.anchor_a[1] / a_scale), &alpha);
         }
         // Anchor boxes: lo ≤ a_i ≤ hi is lo·K ≤ K·a_i ≤ hi·K, linear since K > 0 (exact).
-        for (bx, axes, first) in [
-            (&s.bounds.box_a, &s.axes_a, s.column + 1),
-            (&s.bounds.box_b, &s.axes_b, s.column + 1 + na),
+        // A node's intervals lie within the case's boxes and replace them.
+        for (bx, axes, first, is_b) in [
+            (&s.bounds.box_a, &s.axes_a, s.column + 1, false),
+            (&s.bounds.box_b, &s.axes_b, s.column + 1 + na, true),
         ] {
             for (i, &axis) in axes.iter().enumerate() {
-                let [lo, hi] = bx[axis];
+                let [lo, hi] = match node {
+                    Some(node_box) => node_box.anchor(problem, spring, is_b, i),
+                    None => bx[axis],
+                };
                 let coord = xn(first + i);
                 let c_scale = natural[first + i] / big_k;
                 if lo.is_finite() {
@@ -354,6 +460,52 @@ pub fn solve_relaxation(
             let mut down = k.scaled(bound);
             down.add_scaled(&w, 1.0);
             cp.nonneg(&down);
+        }
+        // A node's McCormick rows: with a_i ∈ [al, ah] and b_l ∈ [bl, bh], each of the four
+        // products (a_i − c)(b_l − d) ≥ 0 or ≤ 0 at the corners, multiplied by K > 0, is a
+        // linear row in (K, K a_i, K b_l, K a_i b_l).
+        if let Some(node_box) = node {
+            // The anchors' lower norm bounds |a| ≥ a_lo: over the box each a_i² is at most its
+            // secant (lo + hi)·a_i − lo·hi, so Σ secants ≥ a_lo² holds at every point of the
+            // box that meets the bound; times K it is linear in (K, K a).
+            for (is_b, first, n, floor) in [
+                (false, s.column + 1, na, s.bounds.anchor_a[0]),
+                (true, s.column + 1 + na, nb, s.bounds.anchor_b[0]),
+            ] {
+                if floor <= 0.0 || n == 0 {
+                    continue;
+                }
+                let unit = floor * floor;
+                let mut e = k.scaled(-unit * big_k);
+                for i in 0..n {
+                    let [lo, hi] = node_box.anchor(problem, spring, is_b, i);
+                    e.add_scaled(&xn(first + i), (lo + hi) * natural[first + i]);
+                    e.add_scaled(&k, -lo * hi * big_k);
+                }
+                cp.nonneg(&e.scaled(1.0 / (unit * big_k)));
+            }
+            for i in 0..na {
+                for l in 0..nb {
+                    let [al, ah] = node_box.anchor(problem, spring, false, i);
+                    let [bl, bh] = node_box.anchor(problem, spring, true, l);
+                    let wj = s.column + 1 + na + nb + i * nb + l;
+                    let big_w = natural[wj];
+                    let w = xn(wj).scaled(natural[wj] / big_w);
+                    let alpha_i = alpha[i].scaled(natural[s.column + 1 + i] / big_w);
+                    let beta_l = beta[l].scaled(natural[s.column + 1 + na + l] / big_w);
+                    let kk = k.scaled(big_k / big_w);
+                    // sign·(W − c β − d α + c d K) ≥ 0 for (c, d, sign).
+                    for (c, d, sign) in
+                        [(al, bl, 1.0), (ah, bh, 1.0), (ah, bl, -1.0), (al, bh, -1.0)]
+                    {
+                        let mut e = w.clone();
+                        e.add_scaled(&beta_l, -c);
+                        e.add_scaled(&alpha_i, -d);
+                        e.add_scaled(&kk, c * d);
+                        cp.nonneg(&e.scaled(sign));
+                    }
+                }
+            }
         }
     }
 
@@ -427,15 +579,63 @@ pub fn solve_relaxation(
             }
         }
     }
-    let solution = solve_with_lazy_peaks(&mut cp, &peaks, max_iter);
-    let zv = DVector::from_iterator(d, z.iter().zip(&dz).map(|(&j, &s)| solution.x[j] * s));
-    Relaxed {
-        bound: tau_scale
-            * solution.objective.min(solution.dual_objective)
-            * (1.0 - BOUND_MARGIN.max(10.0 * solution.tolerance)),
-        z: zv,
-        solution,
+    Built {
+        cp,
+        peaks,
+        z,
+        dz,
+        tau_scale,
+        natural,
     }
+}
+
+/// The range of lifted variable `column` over the bounds-only relaxation restricted to `node`
+/// (an interval that holds every physical point of the box): two solves, minimising and
+/// maximising it. `None` when either solve does not end `Solved`; an empty interval when the
+/// relaxation is infeasible.
+pub fn lifted_range(
+    problem: &VariantProblem,
+    node: Option<&NodeBox>,
+    column: usize,
+    max_iter: u32,
+) -> Option<[f64; 2]> {
+    let mut out = [0.0; 2];
+    for (side, sign) in [(0, 1.0), (1, -1.0)] {
+        let Built {
+            mut cp,
+            z,
+            dz,
+            natural,
+            ..
+        } = build(problem, &[], Objective::Minimax, node);
+        cp.objective.iter_mut().for_each(|c| *c = 0.0);
+        let mut constant = problem.particular[column] / natural[column];
+        for k in 0..problem.dim() {
+            cp.objective[z[k]] = sign * problem.nullspace[(column, k)] * dz[k] / natural[column];
+        }
+        constant *= sign;
+        let solution = cp.solve(max_iter);
+        if solution.status.is_infeasible() {
+            return Some([f64::INFINITY, f64::NEG_INFINITY]);
+        }
+        if solution.status != ConicStatus::Solved {
+            return None;
+        }
+        let low = solution.objective.min(solution.dual_objective) + constant;
+        let margin = (BOUND_MARGIN.max(10.0 * solution.tolerance)) * (1.0 + low.abs());
+        out[side] = sign * (low - margin) * natural[column];
+    }
+    Some(out)
+}
+
+/// `lo ≤ value·scale ≤ hi` for the normalised expression `value`.
+fn within(cp: &mut ConicProblem, value: &Affine, [lo, hi]: [f64; 2], scale: f64) {
+    let mut e = value.clone();
+    e.constant -= lo / scale;
+    cp.nonneg(&e);
+    let mut e = value.scaled(-1.0);
+    e.constant += hi / scale;
+    cp.nonneg(&e);
 }
 
 /// Below this relative level a peak row is far enough from active to be left out of a round.

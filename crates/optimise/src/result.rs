@@ -87,6 +87,9 @@ pub struct Iteration {
     /// Relative gap between the relaxation and the true value at its recovered point, before
     /// local refinement.
     pub gap_before_refinement: f64,
+    /// Boxes the certified branch-and-bound solved in this pass (0: the local search's design
+    /// was already within the gap tolerance of the relaxation's bound).
+    pub boxes: usize,
 }
 
 /// The optimisation result of one balanced variant.

@@ -406,6 +406,7 @@ pub type Realized = (Vec<SpringValues>, DVector<f64>);
 pub struct StartRecord {
     x: DVector<f64>,
     joint: bool,
+    seed: u64,
     outcomes: Vec<(DVector<f64>, f64, f64)>,
     reused: usize,
 }
@@ -420,8 +421,8 @@ impl StartRecord {
     /// starts after the first draw their points from the same pseudo-random stream when the
     /// first start drew the same numbers (it draws a stiffness for each spring whose lifted
     /// `K` is not positive), and the local solve reads `x` only outside the springs' columns.
-    fn repeats(&self, problem: &VariantProblem, x: &DVector<f64>, joint: bool) -> bool {
-        if joint || self.joint || x.len() != self.x.len() {
+    fn repeats(&self, problem: &VariantProblem, x: &DVector<f64>, joint: bool, seed: u64) -> bool {
+        if joint || self.joint || x.len() != self.x.len() || seed != self.seed {
             return false;
         }
         let mut spring_column = vec![false; x.len()];
@@ -466,18 +467,37 @@ pub fn realize_springs_reusing(
     joint: bool,
     previous: Option<&StartRecord>,
 ) -> (Vec<Realized>, String, StartRecord) {
+    realize_springs_seeded(problem, b, x, starts, joint, previous, DEFAULT_SEED)
+}
+
+/// The seed of the starts after the first (the first start is the lifted point itself).
+pub const DEFAULT_SEED: u64 = 0x5917_6e55_0000_0001;
+
+/// [`realize_springs_reusing`] with the starts after the first drawn from `seed`'s stream.
+/// The certified stage makes the verdicts and optima independent of it; `run --seed` sets it to
+/// show that.
+pub fn realize_springs_seeded(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    x: &DVector<f64>,
+    starts: usize,
+    joint: bool,
+    previous: Option<&StartRecord>,
+    seed: u64,
+) -> (Vec<Realized>, String, StartRecord) {
     let lay = layout(problem, joint);
     let mut record = StartRecord {
         x: x.clone(),
         joint,
+        seed,
         outcomes: Vec::new(),
         reused: 0,
     };
     if lay.unknowns == 0 {
         return (vec![(Vec::new(), x.clone())], String::new(), record);
     }
-    let reuse = previous.filter(|p| p.repeats(problem, x, joint));
-    let mut rng = SplitMix64::new(0x5917_6e55_0000_0001);
+    let reuse = previous.filter(|p| p.repeats(problem, x, joint, seed));
+    let mut rng = SplitMix64::new(seed);
     let mut found: Vec<Realized> = Vec::new();
     let mut best = (f64::INFINITY, f64::INFINITY);
     for start in 0..starts.max(1) {

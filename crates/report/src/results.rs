@@ -270,6 +270,10 @@ pub struct OptimiserInfo {
     /// Critical-task iterations (Proc-5…8).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub iterations: Option<usize>,
+    /// Boxes the certified branch-and-bound solved (0: the local search's design was within
+    /// the gap tolerance of the relaxation's bound).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub boxes: Option<usize>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub message: Option<String>,
 }

@@ -1,0 +1,471 @@
+//! The certified spring stage: spatial branch-and-bound over the anchors (and counterweights)
+//! of one balanced variant (docs/design.md §3, "after the balance stage").
+//!
+//! A realizable variant is worth building only if a design exists *within the bounds*, and its
+//! rank means something only if its optimum is the optimum. Both are questions over a box whose
+//! only non-convexities are the spring coupling `W = K a⊗b` (bilinear in the anchors once
+//! homogenised by `K`) and the counterweights' `μμᵀ/m` and `m^{5/3}`. The search:
+//!
+//! - **bounds** each box from below with the convex relaxation restricted to it
+//!   ([`crate::relaxation::solve_relaxation_in`]); a box the relaxation proves infeasible (or
+//!   whose anchors all lie inside an anchor's lower norm bound) holds no design;
+//! - **finds designs** in a box from its relaxed point: counterweights projected and refined
+//!   ([`crate::refine`]), springs polished from the relaxed anchors ([`crate::springs`], one
+//!   deterministic start); a design counts only when every bound and peak limit holds;
+//! - **splits** the box at the midpoint of the coordinate that carries the largest relaxation
+//!   error (the spring coupling error `|W − αβ/K|` shared by its two anchor components, times
+//!   their relative widths), or, when the springs' error is negligible, of the widest
+//!   counterweight coordinate; midpoint splits shrink every box, so the relaxation converges
+//!   to the true problem and the search terminates;
+//! - **stops** when the best design is within the gap tolerance of the smallest open bound
+//!   (certified optimum), when no box is left (proved impossible), or at the node budget
+//!   (the only undecided outcome, a user-set limit).
+//!
+//! The order of work is fixed (best bound first, ties by creation order) and every step is
+//! deterministic, so the verdict, the design and the bound do not depend on threads or batches.
+
+pub mod node;
+
+use std::sync::Arc;
+
+use nalgebra::DVector;
+
+use crate::clarabel_map::ConicStatus;
+use crate::problem::{CwPhysical, Objective, VariantProblem};
+use crate::refine::{
+    FEASIBILITY_TOL, counterweight_directions, merit, project_fixed, project_radius, refine,
+};
+use crate::relaxation::solve_relaxation_in;
+use crate::springs::{SpringValues, realize_springs};
+use crate::torque::TaskTorques;
+use node::{Coordinate, NodeBox, coordinates};
+
+/// Settings of the search.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BranchOptions {
+    /// Relative gap `(design − bound)/design` at which the search stops.
+    pub gap_tolerance: f64,
+    /// Boxes solved at most (the user-set limit).
+    pub max_nodes: usize,
+    /// clarabel iteration limit per box.
+    pub solver_iterations: u32,
+}
+
+/// A verified design: every bound and peak limit holds on the tasks searched.
+#[derive(Clone, Debug)]
+pub struct Design {
+    /// The full lifted point (springs realized).
+    pub x: DVector<f64>,
+    pub cws: Vec<CwPhysical>,
+    pub springs: Vec<SpringValues>,
+    /// The objective on the tasks searched, N·m.
+    pub value: f64,
+}
+
+/// How the search ended.
+#[derive(Clone, Debug)]
+pub enum Verdict {
+    /// The design is within the gap tolerance of the certified lower bound.
+    Optimal {
+        design: Design,
+        lower_bound: f64,
+        nodes: usize,
+    },
+    /// Every box was proved to hold no design.
+    Impossible { nodes: usize },
+    /// The node budget ran out: the best design so far (if any) and the certified bound.
+    Stopped {
+        design: Option<Design>,
+        lower_bound: f64,
+        nodes: usize,
+    },
+}
+
+/// One open box with its relaxation.
+struct Open {
+    bound: f64,
+    order: usize,
+    node: NodeBox,
+    /// The relaxed free coordinates, when the relaxation was solved.
+    z: Option<DVector<f64>>,
+}
+
+/// Solves the relaxation on `node`; `None` when the box is proved to hold no point (the
+/// relaxation is infeasible, or an anchor's lower norm bound excludes the whole box).
+fn bound_box(
+    problem: &VariantProblem,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    options: &BranchOptions,
+    node: NodeBox,
+    parent_bound: f64,
+    order: usize,
+) -> Option<Open> {
+    if node.is_empty() || node.inside_anchor_floor(problem).is_some() {
+        return None;
+    }
+    let relaxed = solve_relaxation_in(
+        problem,
+        tasks,
+        objective,
+        options.solver_iterations,
+        Some(&node),
+    );
+    match relaxed.solution.status {
+        ConicStatus::PrimalInfeasible => None,
+        ConicStatus::Solved if relaxed.z.iter().all(|v| v.is_finite()) => Some(Open {
+            bound: relaxed.bound.max(parent_bound),
+            order,
+            node,
+            z: Some(relaxed.z),
+        }),
+        // Not solved (nor proved infeasible): the box keeps its parent's bound and is split.
+        _ => Some(Open {
+            bound: parent_bound,
+            order,
+            node,
+            z: None,
+        }),
+    }
+}
+
+/// A design from a box's relaxed point, if one meets every bound and limit.
+fn design_at(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    z: &DVector<f64>,
+    scale: f64,
+) -> Option<Design> {
+    let z = project_fixed(problem, z);
+    let dirs = counterweight_directions(problem);
+    let z = project_radius(problem, &z, &dirs).unwrap_or(z);
+    let (_, _, violation) = merit(problem, tasks, objective, &z, scale);
+    let z = if violation <= FEASIBILITY_TOL || problem.counterweights.is_empty() {
+        z
+    } else {
+        let refined = refine(problem, tasks, objective, &z, &dirs, scale);
+        if !refined.feasible {
+            return None;
+        }
+        refined.z
+    };
+    let x = problem.lifted(&z);
+    let accept = |springs: Vec<SpringValues>, x_full: DVector<f64>| -> Option<Design> {
+        let cws = problem.cw_physical(&x_full);
+        if cws.iter().any(|c| !(c.mass > 0.0)) {
+            return None;
+        }
+        let e = problem.evaluate(&cws, tasks);
+        let worst = problem
+            .bound_violations(&x_full)
+            .into_iter()
+            .fold(problem.peak_excess(&e), f64::max);
+        (worst <= FEASIBILITY_TOL).then(|| Design {
+            value: e.objective(objective, problem.actuators),
+            x: x_full,
+            cws,
+            springs,
+        })
+    };
+    let (found, _) = realize_springs(problem, b, &x, 1, false);
+    if let Some(d) = found.into_iter().find_map(|(s, xf)| accept(s, xf)) {
+        return Some(d);
+    }
+    if problem.counterweights.is_empty() {
+        return None;
+    }
+    let (joint, _) = realize_springs(problem, b, &x, 1, true);
+    joint
+        .into_iter()
+        .filter_map(|(s, xf)| accept(s, xf))
+        .min_by(|p, q| p.value.total_cmp(&q.value))
+}
+
+/// The coordinate to split. The objective depends on the counterweights alone (massless
+/// springs never change a balanced variant's motor torques), so when the true objective at the
+/// relaxed point exceeds the box's bound by more than the tolerance (`counterweights_first`),
+/// the widest counterweight coordinate (relative to the root box); otherwise the largest
+/// relaxation error of the springs (couplings and anchor floors), weighted by relative width;
+/// failing both, the widest coordinate of any kind.
+fn branching_coordinate(
+    problem: &VariantProblem,
+    coords: &[Coordinate],
+    root: &NodeBox,
+    open: &Open,
+    counterweights_first: bool,
+) -> Option<usize> {
+    let relative = |k: usize| {
+        let w = open.node.ranges[k][1] - open.node.ranges[k][0];
+        let w0 = root.ranges[k][1] - root.ranges[k][0];
+        if w0 > 0.0 && w > NodeBox::split_floor(problem, coords[k]) {
+            w / w0
+        } else {
+            0.0
+        }
+    };
+    let mut score = vec![0.0f64; coords.len()];
+    if let Some(z) = &open.z {
+        let x = problem.lifted(z);
+        let mut first = 0;
+        for s in &problem.springs {
+            let (na, nb) = (s.axes_a.len(), s.axes_b.len());
+            let kk = x[s.column];
+            let unit = kk.abs().max(1e-300)
+                * s.bounds.anchor_a[1].max(1e-3)
+                * s.bounds.anchor_b[1].max(1e-3);
+            for i in 0..na {
+                for l in 0..nb {
+                    let alpha = x[s.column + 1 + i];
+                    let beta = x[s.column + 1 + na + l];
+                    let w = x[s.column + 1 + na + nb + i * nb + l];
+                    let error = ((w * kk - alpha * beta) / kk.abs().max(1e-300)).abs() / unit;
+                    score[first + i] += error;
+                    score[first + na + l] += error;
+                }
+            }
+            // An anchor nearer than its lower norm bound: the relaxation met the bound through
+            // the secants of a_i², so the error is each secant's excess (hi − a_i)(a_i − lo),
+            // which splitting a_i removes.
+            for (offset, n, floor, lifted) in [
+                (0, na, s.bounds.anchor_a[0], s.column + 1),
+                (na, nb, s.bounds.anchor_b[0], s.column + 1 + na),
+            ] {
+                if floor <= 0.0 {
+                    continue;
+                }
+                let anchor: Vec<f64> = (0..n).map(|i| x[lifted + i] / kk).collect();
+                if crate::problem::norm(&anchor) >= floor {
+                    continue;
+                }
+                for (i, &v) in anchor.iter().enumerate() {
+                    let [lo, hi] = open.node.ranges[first + offset + i];
+                    score[first + offset + i] += ((hi - v) * (v - lo)).max(0.0) / (floor * floor);
+                }
+            }
+            first += na + nb;
+        }
+    }
+    let pick = |filter: &dyn Fn(usize) -> bool, weight: &dyn Fn(usize) -> f64| {
+        (0..coords.len())
+            .filter(|&k| filter(k) && relative(k) > 0.0)
+            .map(|k| (k, weight(k)))
+            .filter(|&(_, w)| w > 0.0)
+            .fold(None, |best: Option<(usize, f64)>, (k, w)| match best {
+                Some((_, bw)) if bw >= w => best,
+                _ => Some((k, w)),
+            })
+            .map(|(k, _)| k)
+    };
+    let spring = |k: usize| {
+        matches!(
+            coords[k],
+            Coordinate::AnchorA { .. } | Coordinate::AnchorB { .. }
+        )
+    };
+    if counterweights_first {
+        pick(&|k| !spring(k), &relative)
+            .or_else(|| {
+                pick(&|k| spring(k) && score[k] > 1e-9, &|k| {
+                    score[k] * relative(k)
+                })
+            })
+            .or_else(|| pick(&|_| true, &relative))
+    } else {
+        pick(&|k| spring(k) && score[k] > 1e-9, &|k| {
+            score[k] * relative(k)
+        })
+        .or_else(|| pick(&|k| !spring(k), &relative))
+        .or_else(|| pick(&|_| true, &relative))
+    }
+}
+
+/// The root box with each counterweight's mass and first-moment intervals narrowed to their
+/// range over the bounds-only relaxation (both are lifted variables, linear in the family):
+/// a mass that balance fixes becomes a point, and the corner planes of `μμᵀ/m` start tight.
+/// Every physical point of the box stays inside (the ranges hold the relaxation's points).
+fn tighten(problem: &VariantProblem, mut root: NodeBox, options: &BranchOptions) -> NodeBox {
+    let coords = coordinates(problem);
+    for (k, c) in coords.iter().enumerate() {
+        let column = match *c {
+            Coordinate::Mass { cw } => problem.counterweights[cw].column,
+            Coordinate::Moment { cw, k } => problem.counterweights[cw].column + 1 + k,
+            _ => continue,
+        };
+        if let Some([lo, hi]) =
+            crate::relaxation::lifted_range(problem, Some(&root), column, options.solver_iterations)
+        {
+            let r = &mut root.ranges[k];
+            if lo > hi {
+                // Infeasible: keep the box; its relaxation proves it empty.
+                return root;
+            }
+            r[0] = r[0].max(lo);
+            r[1] = r[1].min(hi).max(r[0]);
+        }
+    }
+    root
+}
+
+/// Branch-and-bound for the variant on `tasks`, starting from an optional design found
+/// otherwise (its value is the first upper bound).
+pub fn branch_and_bound(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    options: &BranchOptions,
+    incumbent: Option<Design>,
+) -> Result<Verdict, String> {
+    let root = tighten(problem, NodeBox::root(problem)?, options);
+    let coords = coordinates(problem);
+    let scale = tasks
+        .iter()
+        .flat_map(|t| t.base.iter())
+        .fold(0.0f64, |a, &v| a.max(v.abs()))
+        .max(1e-9);
+    let mut best = incumbent;
+    let mut nodes = 1;
+    let mut open: Vec<Open> = Vec::new();
+    let mut order = 0;
+    if let Some(o) = bound_box(
+        problem,
+        tasks,
+        objective,
+        options,
+        root.clone(),
+        f64::NEG_INFINITY,
+        order,
+    ) {
+        open.push(o);
+    }
+    // Boxes too small to split that hold no design: their bounds stay in the global one.
+    let mut stuck: Vec<f64> = Vec::new();
+    // The smallest bound of the boxes closed because their bound came within the tolerance of
+    // the best design: part of the certified lower bound.
+    let mut pruned = f64::INFINITY;
+    let closes = |bound: f64, best: &Option<Design>| {
+        best.as_ref().is_some_and(|d| {
+            d.value - bound <= options.gap_tolerance * d.value.abs().max(f64::MIN_POSITIVE)
+        })
+    };
+    loop {
+        let lowest = open
+            .iter()
+            .map(|o| o.bound)
+            .chain(stuck.iter().copied())
+            .fold(pruned, f64::min);
+        if open.is_empty() || closes(lowest, &best) {
+            return Ok(match best {
+                Some(design) if stuck.is_empty() || closes(lowest, &Some(design.clone())) => {
+                    let lower_bound = lowest.min(design.value);
+                    Verdict::Optimal {
+                        design,
+                        lower_bound,
+                        nodes,
+                    }
+                }
+                None if stuck.is_empty() => Verdict::Impossible { nodes },
+                design => Verdict::Stopped {
+                    design,
+                    lower_bound: lowest,
+                    nodes,
+                },
+            });
+        }
+        if nodes >= options.max_nodes {
+            return Ok(Verdict::Stopped {
+                design: best,
+                lower_bound: lowest,
+                nodes,
+            });
+        }
+        // Best bound first; among bounds within half the gap tolerance of the lowest (a tie:
+        // for a springs-only variant every box has the same bound), the newest box, so that
+        // the search dives to boxes small enough to hold a design before it widens.
+        let tie = lowest + 0.5 * options.gap_tolerance * lowest.abs();
+        let at = (0..open.len())
+            .filter(|&p| open[p].bound <= tie)
+            .max_by_key(|&p| open[p].order)
+            .unwrap_or_else(|| {
+                (0..open.len())
+                    .min_by(|&p, &q| open[p].bound.total_cmp(&open[q].bound))
+                    .expect("open is not empty")
+            });
+        let current = open.swap_remove(at);
+        if let Some(z) = &current.z
+            && let Some(d) = design_at(problem, b, tasks, objective, z, scale)
+            && best.as_ref().is_none_or(|bd| d.value < bd.value)
+        {
+            best = Some(d);
+        }
+        if closes(current.bound, &best) {
+            pruned = pruned.min(current.bound);
+            continue;
+        }
+        let counterweights_first = current.z.as_ref().is_some_and(|z| {
+            let (_, value, _) = merit(problem, tasks, objective, z, scale);
+            value - current.bound > options.gap_tolerance * value.abs()
+        });
+        let Some(k) = branching_coordinate(problem, &coords, &root, &current, counterweights_first)
+        else {
+            stuck.push(current.bound);
+            continue;
+        };
+        for child in current.node.split(k) {
+            nodes += 1;
+            order += 1;
+            let Some(o) = bound_box(
+                problem,
+                tasks,
+                objective,
+                options,
+                child,
+                current.bound,
+                order,
+            ) else {
+                continue;
+            };
+            if closes(o.bound, &best) {
+                pruned = pruned.min(o.bound);
+            } else {
+                open.push(o);
+            }
+        }
+    }
+}
+
+/// The bounds a design must meet, in words, for a certificate: each spring's stiffness and
+/// anchor ranges, each counterweight's mass and offset ranges.
+pub fn bounds_in_words(problem: &VariantProblem) -> String {
+    const AXIS: [&str; 3] = ["x", "y", "z"];
+    let mut parts = Vec::new();
+    for s in &problem.springs {
+        let mut p = format!(
+            "{}: K ∈ [{}, {}] N/m, |a| ∈ [{}, {}] m, |b| ∈ [{}, {}] m",
+            s.label,
+            s.bounds.stiffness[0],
+            s.bounds.stiffness[1],
+            s.bounds.anchor_a[0],
+            s.bounds.anchor_a[1],
+            s.bounds.anchor_b[0],
+            s.bounds.anchor_b[1]
+        );
+        for (name, bx) in [("a", &s.bounds.box_a), ("b", &s.bounds.box_b)] {
+            for (axis, r) in bx.iter().enumerate() {
+                if r[0].is_finite() || r[1].is_finite() {
+                    p.push_str(&format!(", {name}_{} ∈ [{}, {}] m", AXIS[axis], r[0], r[1]));
+                }
+            }
+        }
+        parts.push(p);
+    }
+    for c in &problem.counterweights {
+        parts.push(format!(
+            "{}: m ∈ [{}, {}] kg, |r| ∈ [{}, {}] m",
+            c.label, c.bounds.mass[0], c.bounds.mass[1], c.bounds.radius[0], c.bounds.radius[1]
+        ));
+    }
+    parts.join("; ")
+}
