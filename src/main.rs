@@ -114,7 +114,7 @@ enum Command {
         gap: f64,
         /// Boxes the certified search may solve per variant and pass; a variant that reaches
         /// the limit before a verdict ends undecided, and says so.
-        #[arg(long, default_value_t = 2000, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+        #[arg(long, default_value_t = counterpoise_optimise::certify::DEFAULT_MAX_NODES as u64, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
         max_nodes: u64,
         /// Seed of the local search's starting points (verdicts, optima and ranks do not
         /// depend on it).

@@ -81,7 +81,7 @@ impl Default for OptimiseOptions {
             spring_starts: 8,
             final_reactions: true,
             solver_iterations: 200,
-            max_nodes: 2000,
+            max_nodes: crate::certify::DEFAULT_MAX_NODES,
             start_seed: crate::springs::DEFAULT_SEED,
         }
     }
@@ -639,7 +639,7 @@ fn fast_design(
 }
 
 /// Boxes the bounds-only search may use to word a certificate.
-const CERTIFICATE_NODES: usize = 200;
+const CERTIFICATE_NODES: usize = 30;
 
 /// The certificate of a variant the search proved impossible: the bounds alone when the
 /// bounds-only search also finds no box (else the peak limits on the working set), with the

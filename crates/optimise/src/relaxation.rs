@@ -49,6 +49,10 @@ pub struct Relaxed {
     /// The lower bound: the smaller of the primal and dual objective values (the dual value is
     /// the certificate; clarabel's primal value may exceed the optimum by its tolerance).
     pub bound: f64,
+    /// Per counterweight, how far the relaxed second moments and `p` are from the physical
+    /// `μμᵀ/m` and `m^{5/3}` at the relaxed `(m, μ)`, relative to their scales (0 when solved
+    /// exactly; what the branch-and-bound splits to remove).
+    pub cw_errors: Vec<f64>,
 }
 
 /// Index of the `S` entry `(a, b)`, `a ≤ b`, among a counterweight's axes pairs.
@@ -176,29 +180,13 @@ pub fn solve_relaxation_in(
     max_iter: u32,
     node: Option<&NodeBox>,
 ) -> Relaxed {
-    let Built {
-        mut cp,
-        peaks,
-        z,
-        dz,
-        tau_scale,
-        ..
-    } = build(problem, tasks, objective, node);
-    let d = problem.dim();
-    let solution = solve_with_lazy_peaks(&mut cp, &peaks, max_iter);
-    let zv = DVector::from_iterator(d, z.iter().zip(&dz).map(|(&j, &s)| solution.x[j] * s));
-    Relaxed {
-        bound: tau_scale
-            * solution.objective.min(solution.dual_objective)
-            * (1.0 - BOUND_MARGIN.max(10.0 * solution.tolerance)),
-        z: zv,
-        solution,
-    }
+    RelaxationBase::new(problem, tasks, objective).solve(problem, node, max_iter, &mut Vec::new())
 }
 
 /// A relaxation ready to solve: the problem, its lazily added peak rows, the conic variables of
 /// the scaled free coordinates `ζ` (`z = D ζ`, `dz` the diagonal of `D`), the torque scale, and
 /// the natural magnitude of each lifted variable.
+#[derive(Clone)]
 struct Built {
     cp: ConicProblem,
     peaks: Vec<Affine>,
@@ -206,15 +194,300 @@ struct Built {
     dz: Vec<f64>,
     tau_scale: f64,
     natural: Vec<f64>,
+    cw_vars: Vec<CwVars>,
+}
+
+/// A counterweight's own conic variables: its normalised second moments (one per pair of plane
+/// axes, in [`pairs`] order), `p` standing for `m^{5/3}` (when the shape has inertia), and the
+/// second moments' scale `σ`.
+#[derive(Clone)]
+struct CwVars {
+    s_vars: Vec<usize>,
+    p: Option<usize>,
+    sigma: f64,
+}
+
+impl Built {
+    /// `x_j / natural_j` as an affine expression of the scaled free coordinates.
+    fn xn(&self, problem: &VariantProblem, j: usize) -> Affine {
+        let mut e = Affine::constant(problem.particular[j] / self.natural[j]);
+        for k in 0..problem.dim() {
+            let c = problem.nullspace[(j, k)] * self.dz[k] / self.natural[j];
+            if c != 0.0 {
+                e.add_var(self.z[k], c);
+            }
+        }
+        e
+    }
+
+    /// Solves, with the peak rows added lazily (those marked in `active` from the start;
+    /// `active` returns the rows used).
+    fn solve(mut self, problem: &VariantProblem, max_iter: u32, active: &mut Vec<bool>) -> Relaxed {
+        active.resize(self.peaks.len(), false);
+        let solution = solve_with_peaks_from(&mut self.cp, &self.peaks, active, max_iter);
+        let zv = DVector::from_iterator(
+            problem.dim(),
+            self.z
+                .iter()
+                .zip(&self.dz)
+                .map(|(&j, &s)| solution.x[j] * s),
+        );
+        let x = problem.lifted(&zv);
+        let cw_errors = problem
+            .counterweights
+            .iter()
+            .zip(&self.cw_vars)
+            .map(|(c, vars)| {
+                let m = x[c.column];
+                if !(m > 0.0) || solution.x.len() <= vars.s_vars.iter().copied().max().unwrap_or(0)
+                {
+                    return 0.0;
+                }
+                let n = c.axes.len();
+                let mu: Vec<f64> = (0..n).map(|k| x[c.column + 1 + k]).collect();
+                let mut error = 0.0;
+                for (idx, &(a, b)) in pairs(n).iter().enumerate() {
+                    let relaxed = solution.x[vars.s_vars[idx]] * vars.sigma;
+                    error += (relaxed - mu[a] * mu[b] / m).abs() / vars.sigma;
+                }
+                if let Some(p) = vars.p {
+                    let big_p = self.natural[c.column].powf(5.0 / 3.0);
+                    error += (solution.x[p] * big_p - m.powf(5.0 / 3.0)).abs() / big_p;
+                }
+                error
+            })
+            .collect();
+        Relaxed {
+            bound: self.tau_scale
+                * solution.objective.min(solution.dual_objective)
+                * (1.0 - BOUND_MARGIN.max(10.0 * solution.tolerance)),
+            z: zv,
+            solution,
+            cw_errors,
+        }
+    }
+}
+
+/// The relaxation of one variant on one set of tasks, built once and solved on many boxes:
+/// a node's rows ([`solve_relaxation_in`]) are appended to a copy of it.
+#[derive(Clone)]
+pub struct RelaxationBase(Built);
+
+impl RelaxationBase {
+    pub fn new(problem: &VariantProblem, tasks: &[Arc<TaskTorques>], objective: Objective) -> Self {
+        RelaxationBase(build(problem, tasks, objective))
+    }
+
+    /// Solves the relaxation restricted to `node` (the whole family when `None`). The peak
+    /// rows marked in `active` enter from the first round, and `active` returns the rows the
+    /// solve used: a search that passes it from box to box saves the rounds of cutting planes
+    /// (each round of any set of rows is a valid relaxation, so the bound is the same kind).
+    pub fn solve(
+        &self,
+        problem: &VariantProblem,
+        node: Option<&NodeBox>,
+        max_iter: u32,
+        active: &mut Vec<bool>,
+    ) -> Relaxed {
+        let mut built = self.0.clone();
+        if let Some(node) = node {
+            add_node_rows(problem, &mut built, node);
+        }
+        built.solve(problem, max_iter, active)
+    }
+
+    /// The range of lifted variable `column` over this relaxation restricted to `node` (an
+    /// interval that holds every physical point of the box): two solves, minimising and
+    /// maximising it, with the task objective dropped. `None` when either solve does not end
+    /// `Solved`; an empty interval when the relaxation is infeasible.
+    pub fn lifted_range(
+        &self,
+        problem: &VariantProblem,
+        node: Option<&NodeBox>,
+        column: usize,
+        max_iter: u32,
+    ) -> Option<[f64; 2]> {
+        let mut out = [0.0; 2];
+        for (side, sign) in [(0, 1.0), (1, -1.0)] {
+            let mut built = self.0.clone();
+            if let Some(node) = node {
+                add_node_rows(problem, &mut built, node);
+            }
+            let natural = built.natural[column];
+            built.cp.objective.iter_mut().for_each(|c| *c = 0.0);
+            for k in 0..problem.dim() {
+                built.cp.objective[built.z[k]] =
+                    sign * problem.nullspace[(column, k)] * built.dz[k] / natural;
+            }
+            let constant = sign * problem.particular[column] / natural;
+            let solution = built.cp.solve(max_iter);
+            if solution.status.is_infeasible() {
+                return Some([f64::INFINITY, f64::NEG_INFINITY]);
+            }
+            if solution.status != ConicStatus::Solved {
+                return None;
+            }
+            let low = solution.objective.min(solution.dual_objective) + constant;
+            let margin = (BOUND_MARGIN.max(10.0 * solution.tolerance)) * (1.0 + low.abs());
+            out[side] = sign * (low - margin) * natural;
+        }
+        Some(out)
+    }
+}
+
+/// Appends a node's rows (see [`solve_relaxation_in`]).
+fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
+    let natural = built.natural.clone();
+    for (cw, c) in problem.counterweights.iter().enumerate() {
+        let vars = built.cw_vars[cw].clone();
+        let big_m = natural[c.column];
+        let mn = built.xn(problem, c.column);
+        let n_ax = c.axes.len();
+        let mun: Vec<Affine> = (0..n_ax)
+            .map(|k| built.xn(problem, c.column + 1 + k))
+            .collect();
+        let big_r = if n_ax > 0 { natural[c.column + 1] } else { 1.0 };
+        let sigma = vars.sigma;
+        let ps = pairs(n_ax);
+        let s_of = |a: usize, b: usize| {
+            let (a, b) = if a <= b { (a, b) } else { (b, a) };
+            vars.s_vars[ps.iter().position(|&p| p == (a, b)).expect("pair")]
+        };
+        let cp = &mut built.cp;
+        let [lo, hi] = node.mass(problem, cw);
+        let intervals: Vec<[f64; 2]> = (0..n_ax).map(|k| node.moment(problem, cw, k)).collect();
+        within(cp, &mn, [lo, hi], big_m);
+        for (k, &r) in intervals.iter().enumerate() {
+            within(cp, &mun[k], r, big_r);
+        }
+        // S_aa = μ_a²/m below the corner planes; along the diagonals likewise.
+        let below = |cp: &mut ConicProblem, s: &Affine, u: &Affine, r: [f64; 2]| {
+            for [c0, c1, c2] in square_over_linear_planes(r, [lo, hi]) {
+                let mut e = Affine::constant(c0 / sigma);
+                e.add_scaled(u, c1 * big_r / sigma);
+                e.add_scaled(&mn, c2 * big_m / sigma);
+                e.add_scaled(s, -1.0);
+                cp.nonneg(&e);
+            }
+        };
+        for ka in 0..n_ax {
+            below(cp, &Affine::var(s_of(ka, ka)), &mun[ka], intervals[ka]);
+        }
+        for ka in 0..n_ax {
+            for kb in ka + 1..n_ax {
+                let (ia, ib) = (intervals[ka], intervals[kb]);
+                let h = std::f64::consts::FRAC_1_SQRT_2;
+                for sign in [1.0, -1.0] {
+                    let mut sd = Affine::var(s_of(ka, ka)).scaled(0.5);
+                    sd.add_var(s_of(kb, kb), 0.5);
+                    sd.add_var(s_of(ka, kb), sign);
+                    let mut u = mun[ka].scaled(h);
+                    u.add_scaled(&mun[kb], sign * h);
+                    let r = if sign > 0.0 {
+                        [h * (ia[0] + ib[0]), h * (ia[1] + ib[1])]
+                    } else {
+                        [h * (ia[0] - ib[1]), h * (ia[1] - ib[0])]
+                    };
+                    below(cp, &sd, &u, r);
+                }
+            }
+        }
+        // p = m^{5/3} below its chord over the node's mass interval.
+        if let Some(p) = vars.p
+            && hi > lo
+        {
+            let big_p = big_m.powf(5.0 / 3.0);
+            let (plo, phi) = (lo.powf(5.0 / 3.0), hi.powf(5.0 / 3.0));
+            let slope = (phi - plo) / (hi - lo);
+            let mut chord = mn.scaled(slope * big_m / big_p);
+            chord.constant += (plo - slope * lo) / big_p;
+            chord.add_var(p, -1.0);
+            cp.nonneg(&chord);
+        }
+    }
+    for (spring, s) in problem.springs.iter().enumerate() {
+        let k = built.xn(problem, s.column);
+        let na = s.axes_a.len();
+        let nb = s.axes_b.len();
+        let alpha: Vec<Affine> = (0..na)
+            .map(|i| built.xn(problem, s.column + 1 + i))
+            .collect();
+        let beta: Vec<Affine> = (0..nb)
+            .map(|i| built.xn(problem, s.column + 1 + na + i))
+            .collect();
+        let w_of: Vec<Affine> = (0..na * nb)
+            .map(|i| built.xn(problem, s.column + 1 + na + nb + i))
+            .collect();
+        let big_k = natural[s.column];
+        let cp = &mut built.cp;
+        // The node's anchor intervals: lo ≤ a_i ≤ hi is lo·K ≤ K·a_i ≤ hi·K (exact, K > 0).
+        for (first, n, is_b, coords) in [
+            (s.column + 1, na, false, &alpha),
+            (s.column + 1 + na, nb, true, &beta),
+        ] {
+            for i in 0..n {
+                let [lo, hi] = node.anchor(problem, spring, is_b, i);
+                let c_scale = natural[first + i] / big_k;
+                let mut e = coords[i].clone();
+                e.add_scaled(&k, -lo / c_scale);
+                cp.nonneg(&e);
+                let mut e = k.scaled(hi / c_scale);
+                e.add_scaled(&coords[i], -1.0);
+                cp.nonneg(&e);
+            }
+        }
+        // A node's McCormick rows: with a_i ∈ [al, ah] and b_l ∈ [bl, bh], each of the four
+        // products (a_i − c)(b_l − d) ≥ 0 or ≤ 0 at the corners, multiplied by K > 0, is a
+        // linear row in (K, K a_i, K b_l, K a_i b_l).
+        {
+            let node_box = node;
+            // The anchors' lower norm bounds |a| ≥ a_lo: over the box each a_i² is at most its
+            // secant (lo + hi)·a_i − lo·hi, so Σ secants ≥ a_lo² holds at every point of the
+            // box that meets the bound; times K it is linear in (K, K a).
+            for (is_b, first, n, floor, coords) in [
+                (false, s.column + 1, na, s.bounds.anchor_a[0], &alpha),
+                (true, s.column + 1 + na, nb, s.bounds.anchor_b[0], &beta),
+            ] {
+                if floor <= 0.0 || n == 0 {
+                    continue;
+                }
+                let unit = floor * floor;
+                let mut e = k.scaled(-unit * big_k);
+                for i in 0..n {
+                    let [lo, hi] = node_box.anchor(problem, spring, is_b, i);
+                    e.add_scaled(&coords[i], (lo + hi) * natural[first + i]);
+                    e.add_scaled(&k, -lo * hi * big_k);
+                }
+                cp.nonneg(&e.scaled(1.0 / (unit * big_k)));
+            }
+            for i in 0..na {
+                for l in 0..nb {
+                    let [al, ah] = node_box.anchor(problem, spring, false, i);
+                    let [bl, bh] = node_box.anchor(problem, spring, true, l);
+                    let wj = s.column + 1 + na + nb + i * nb + l;
+                    let big_w = natural[wj];
+                    let w = w_of[i * nb + l].scaled(natural[wj] / big_w);
+                    let alpha_i = alpha[i].scaled(natural[s.column + 1 + i] / big_w);
+                    let beta_l = beta[l].scaled(natural[s.column + 1 + na + l] / big_w);
+                    let kk = k.scaled(big_k / big_w);
+                    // sign·(W − c β − d α + c d K) ≥ 0 for (c, d, sign).
+                    for (c, d, sign) in
+                        [(al, bl, 1.0), (ah, bh, 1.0), (ah, bl, -1.0), (al, bh, -1.0)]
+                    {
+                        let mut e = w.clone();
+                        e.add_scaled(&beta_l, -c);
+                        e.add_scaled(&alpha_i, -d);
+                        e.add_scaled(&kk, c * d);
+                        cp.nonneg(&e.scaled(sign));
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Builds the relaxation (see [`solve_relaxation_in`]).
-fn build(
-    problem: &VariantProblem,
-    tasks: &[Arc<TaskTorques>],
-    objective: Objective,
-    node: Option<&NodeBox>,
-) -> Built {
+fn build(problem: &VariantProblem, tasks: &[Arc<TaskTorques>], objective: Objective) -> Built {
     let mut cp = ConicProblem::default();
     let d = problem.dim();
     let natural = natural_scales(problem);
@@ -243,7 +516,8 @@ fn build(
 
     // Per counterweight: feature expressions (true units) and their torque columns.
     let mut features: Vec<Feature> = Vec::new();
-    for (cw, c) in problem.counterweights.iter().enumerate() {
+    let mut cw_vars: Vec<CwVars> = Vec::new();
+    for c in &problem.counterweights {
         let big_m = natural[c.column];
         let mn = xn(c.column);
         let n_ax = c.axes.len();
@@ -327,52 +601,8 @@ fn build(
         e.constant += mhi / big_m;
         cp.nonneg(&e);
         cp.soc(&mn.scaled(rhi * big_m / big_r), &mun);
-        let (mlo, mhi) = match node {
-            Some(nb) => {
-                let [lo, hi] = nb.mass(problem, cw);
-                let intervals: Vec<[f64; 2]> =
-                    (0..n_ax).map(|k| nb.moment(problem, cw, k)).collect();
-                within(&mut cp, &mn, [lo, hi], big_m);
-                for (k, &r) in intervals.iter().enumerate() {
-                    within(&mut cp, &mun[k], r, big_r);
-                }
-                // S_aa = μ_a²/m below the corner planes; along the diagonals likewise.
-                let below = |cp: &mut ConicProblem, s: &Affine, u: &Affine, r: [f64; 2]| {
-                    for [c0, c1, c2] in square_over_linear_planes(r, [lo, hi]) {
-                        let mut e = Affine::constant(c0 / sigma);
-                        e.add_scaled(u, c1 * big_r / sigma);
-                        e.add_scaled(&mn, c2 * big_m / sigma);
-                        e.add_scaled(s, -1.0);
-                        cp.nonneg(&e);
-                    }
-                };
-                for ka in 0..n_ax {
-                    below(&mut cp, &Affine::var(s_of(ka, ka)), &mun[ka], intervals[ka]);
-                }
-                for ka in 0..n_ax {
-                    for kb in ka + 1..n_ax {
-                        let (ia, ib) = (intervals[ka], intervals[kb]);
-                        let h = std::f64::consts::FRAC_1_SQRT_2;
-                        for sign in [1.0, -1.0] {
-                            let mut sd = Affine::var(s_of(ka, ka)).scaled(0.5);
-                            sd.add_var(s_of(kb, kb), 0.5);
-                            sd.add_var(s_of(ka, kb), sign);
-                            let mut u = mun[ka].scaled(h);
-                            u.add_scaled(&mun[kb], sign * h);
-                            let r = if sign > 0.0 {
-                                [h * (ia[0] + ib[0]), h * (ia[1] + ib[1])]
-                            } else {
-                                [h * (ia[0] - ib[1]), h * (ia[1] - ib[0])]
-                            };
-                            below(&mut cp, &sd, &u, r);
-                        }
-                    }
-                }
-                (lo, hi)
-            }
-            None => (mlo, mhi),
-        };
         // Cylinder inertia: p = P·p', P = M^{5/3}; p'^{3/5} ≥ m/M and p below the chord.
+        let mut p_var = None;
         let j_norm = c.j1.abs().max();
         if j_norm > 0.0 {
             let big_p = big_m.powf(5.0 / 3.0);
@@ -399,10 +629,16 @@ fn build(
                 expr: Affine::var(p).scaled(big_p),
                 parts,
             });
+            p_var = Some(p);
         }
+        cw_vars.push(CwVars {
+            s_vars,
+            p: p_var,
+            sigma,
+        });
     }
     // Spring bounds (the convex ones), normalised.
-    for (spring, s) in problem.springs.iter().enumerate() {
+    for s in &problem.springs {
         let k = xn(s.column);
         let na = s.axes_a.len();
         let nb = s.axes_b.len();
@@ -421,16 +657,12 @@ fn build(
             cp.soc(&k.scaled(s.bounds.anchor_a[1] / a_scale), &alpha);
         }
         // Anchor boxes: lo ≤ a_i ≤ hi is lo·K ≤ K·a_i ≤ hi·K, linear since K > 0 (exact).
-        // A node's intervals lie within the case's boxes and replace them.
-        for (bx, axes, first, is_b) in [
-            (&s.bounds.box_a, &s.axes_a, s.column + 1, false),
-            (&s.bounds.box_b, &s.axes_b, s.column + 1 + na, true),
+        for (bx, axes, first) in [
+            (&s.bounds.box_a, &s.axes_a, s.column + 1),
+            (&s.bounds.box_b, &s.axes_b, s.column + 1 + na),
         ] {
             for (i, &axis) in axes.iter().enumerate() {
-                let [lo, hi] = match node {
-                    Some(node_box) => node_box.anchor(problem, spring, is_b, i),
-                    None => bx[axis],
-                };
+                let [lo, hi] = bx[axis];
                 let coord = xn(first + i);
                 let c_scale = natural[first + i] / big_k;
                 if lo.is_finite() {
@@ -460,52 +692,6 @@ fn build(
             let mut down = k.scaled(bound);
             down.add_scaled(&w, 1.0);
             cp.nonneg(&down);
-        }
-        // A node's McCormick rows: with a_i ∈ [al, ah] and b_l ∈ [bl, bh], each of the four
-        // products (a_i − c)(b_l − d) ≥ 0 or ≤ 0 at the corners, multiplied by K > 0, is a
-        // linear row in (K, K a_i, K b_l, K a_i b_l).
-        if let Some(node_box) = node {
-            // The anchors' lower norm bounds |a| ≥ a_lo: over the box each a_i² is at most its
-            // secant (lo + hi)·a_i − lo·hi, so Σ secants ≥ a_lo² holds at every point of the
-            // box that meets the bound; times K it is linear in (K, K a).
-            for (is_b, first, n, floor) in [
-                (false, s.column + 1, na, s.bounds.anchor_a[0]),
-                (true, s.column + 1 + na, nb, s.bounds.anchor_b[0]),
-            ] {
-                if floor <= 0.0 || n == 0 {
-                    continue;
-                }
-                let unit = floor * floor;
-                let mut e = k.scaled(-unit * big_k);
-                for i in 0..n {
-                    let [lo, hi] = node_box.anchor(problem, spring, is_b, i);
-                    e.add_scaled(&xn(first + i), (lo + hi) * natural[first + i]);
-                    e.add_scaled(&k, -lo * hi * big_k);
-                }
-                cp.nonneg(&e.scaled(1.0 / (unit * big_k)));
-            }
-            for i in 0..na {
-                for l in 0..nb {
-                    let [al, ah] = node_box.anchor(problem, spring, false, i);
-                    let [bl, bh] = node_box.anchor(problem, spring, true, l);
-                    let wj = s.column + 1 + na + nb + i * nb + l;
-                    let big_w = natural[wj];
-                    let w = xn(wj).scaled(natural[wj] / big_w);
-                    let alpha_i = alpha[i].scaled(natural[s.column + 1 + i] / big_w);
-                    let beta_l = beta[l].scaled(natural[s.column + 1 + na + l] / big_w);
-                    let kk = k.scaled(big_k / big_w);
-                    // sign·(W − c β − d α + c d K) ≥ 0 for (c, d, sign).
-                    for (c, d, sign) in
-                        [(al, bl, 1.0), (ah, bh, 1.0), (ah, bl, -1.0), (al, bh, -1.0)]
-                    {
-                        let mut e = w.clone();
-                        e.add_scaled(&beta_l, -c);
-                        e.add_scaled(&alpha_i, -d);
-                        e.add_scaled(&kk, c * d);
-                        cp.nonneg(&e.scaled(sign));
-                    }
-                }
-            }
         }
     }
 
@@ -586,46 +772,8 @@ fn build(
         dz,
         tau_scale,
         natural,
+        cw_vars,
     }
-}
-
-/// The range of lifted variable `column` over the bounds-only relaxation restricted to `node`
-/// (an interval that holds every physical point of the box): two solves, minimising and
-/// maximising it. `None` when either solve does not end `Solved`; an empty interval when the
-/// relaxation is infeasible.
-pub fn lifted_range(
-    problem: &VariantProblem,
-    node: Option<&NodeBox>,
-    column: usize,
-    max_iter: u32,
-) -> Option<[f64; 2]> {
-    let mut out = [0.0; 2];
-    for (side, sign) in [(0, 1.0), (1, -1.0)] {
-        let Built {
-            mut cp,
-            z,
-            dz,
-            natural,
-            ..
-        } = build(problem, &[], Objective::Minimax, node);
-        cp.objective.iter_mut().for_each(|c| *c = 0.0);
-        let mut constant = problem.particular[column] / natural[column];
-        for k in 0..problem.dim() {
-            cp.objective[z[k]] = sign * problem.nullspace[(column, k)] * dz[k] / natural[column];
-        }
-        constant *= sign;
-        let solution = cp.solve(max_iter);
-        if solution.status.is_infeasible() {
-            return Some([f64::INFINITY, f64::NEG_INFINITY]);
-        }
-        if solution.status != ConicStatus::Solved {
-            return None;
-        }
-        let low = solution.objective.min(solution.dual_objective) + constant;
-        let margin = (BOUND_MARGIN.max(10.0 * solution.tolerance)) * (1.0 + low.abs());
-        out[side] = sign * (low - margin) * natural[column];
-    }
-    Some(out)
 }
 
 /// `lo ≤ value·scale ≤ hi` for the normalised expression `value`.
@@ -663,8 +811,20 @@ fn add_peak_row(cp: &mut ConicProblem, e: &Affine) {
 /// the last round's solution meets every row left out with a margin, so it is the full
 /// problem's optimum. A round that clarabel does not solve, or too many rounds, fall back to
 /// the full problem, solved as it always was.
-fn solve_with_lazy_peaks(cp: &mut ConicProblem, peaks: &[Affine], max_iter: u32) -> ConicSolution {
-    let mut added = vec![false; peaks.len()];
+///
+/// The rows `added` marks are in the problem from the first round (a branch-and-bound node
+/// starts from the rows its search found active); `added` returns every row the solve used.
+fn solve_with_peaks_from(
+    cp: &mut ConicProblem,
+    peaks: &[Affine],
+    added: &mut [bool],
+    max_iter: u32,
+) -> ConicSolution {
+    for (k, e) in peaks.iter().enumerate() {
+        if added[k] {
+            add_peak_row(cp, e);
+        }
+    }
     for _ in 0..PEAK_ROUNDS {
         let solution = cp.solve(max_iter);
         if solution.status.is_infeasible() {
@@ -739,7 +899,14 @@ mod tests {
         let reference = full.solve(200);
         assert_eq!(reference.status, ConicStatus::Solved);
         let mut lazy = build();
-        let solution = solve_with_lazy_peaks(&mut lazy, &rows, 200);
+        let mut added = vec![false; rows.len()];
+        let solution = solve_with_peaks_from(&mut lazy, &rows, &mut added, 200);
+        // Starting from the rows that solve used gives the same optimum in one round.
+        let mut again = build();
+        let mut reused = added.clone();
+        let first = solve_with_peaks_from(&mut again, &rows, &mut reused, 200);
+        assert_eq!(reused, added, "no row beyond the first solve's");
+        assert!((first.objective - solution.objective).abs() <= 1e-6 * solution.objective.abs());
         assert_eq!(solution.status, ConicStatus::Solved);
         // The target (3, −2) is outside the feasible set: some row binds.
         assert!(reference.objective > 1e-3);

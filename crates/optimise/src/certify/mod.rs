@@ -35,10 +35,15 @@ use crate::problem::{CwPhysical, Objective, VariantProblem};
 use crate::refine::{
     FEASIBILITY_TOL, counterweight_directions, merit, project_fixed, project_radius, refine,
 };
-use crate::relaxation::solve_relaxation_in;
+use crate::relaxation::RelaxationBase;
 use crate::springs::{SpringValues, realize_springs};
 use crate::torque::TaskTorques;
 use node::{Coordinate, NodeBox, coordinates};
+
+/// Boxes per variant and pass by default: enough for every variant of the palletizer at
+/// Dmax 2 (the most any needs is about 340), and a bound on the time of the few Dmax 3
+/// variants whose search converges slowly (each box is a conic solve of 5–70 ms).
+pub const DEFAULT_MAX_NODES: usize = 400;
 
 /// Settings of the search.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,14 +93,16 @@ struct Open {
     node: NodeBox,
     /// The relaxed free coordinates, when the relaxation was solved.
     z: Option<DVector<f64>>,
+    /// The relaxation's error per counterweight ([`crate::relaxation::Relaxed::cw_errors`]).
+    cw_errors: Vec<f64>,
 }
 
 /// Solves the relaxation on `node`; `None` when the box is proved to hold no point (the
 /// relaxation is infeasible, or an anchor's lower norm bound excludes the whole box).
 fn bound_box(
     problem: &VariantProblem,
-    tasks: &[Arc<TaskTorques>],
-    objective: Objective,
+    base: &RelaxationBase,
+    active: &mut Vec<bool>,
     options: &BranchOptions,
     node: NodeBox,
     parent_bound: f64,
@@ -104,13 +111,7 @@ fn bound_box(
     if node.is_empty() || node.inside_anchor_floor(problem).is_some() {
         return None;
     }
-    let relaxed = solve_relaxation_in(
-        problem,
-        tasks,
-        objective,
-        options.solver_iterations,
-        Some(&node),
-    );
+    let relaxed = base.solve(problem, Some(&node), options.solver_iterations, active);
     match relaxed.solution.status {
         ConicStatus::PrimalInfeasible => None,
         ConicStatus::Solved if relaxed.z.iter().all(|v| v.is_finite()) => Some(Open {
@@ -118,6 +119,7 @@ fn bound_box(
             order,
             node,
             z: Some(relaxed.z),
+            cw_errors: relaxed.cw_errors,
         }),
         // Not solved (nor proved infeasible): the box keeps its parent's bound and is split.
         _ => Some(Open {
@@ -125,6 +127,7 @@ fn bound_box(
             order,
             node,
             z: None,
+            cw_errors: Vec::new(),
         }),
     }
 }
@@ -264,8 +267,15 @@ fn branching_coordinate(
             Coordinate::AnchorA { .. } | Coordinate::AnchorB { .. }
         )
     };
+    // The counterweight whose relaxation is farthest from physical, and its widest coordinate.
+    let worst_cw = (0..open.cw_errors.len())
+        .filter(|&c| open.cw_errors[c] > 0.0)
+        .max_by(|&p, &q| open.cw_errors[p].total_cmp(&open.cw_errors[q]));
+    let of_cw = |k: usize, cw: usize| matches!(coords[k], Coordinate::Mass { cw: c } | Coordinate::Moment { cw: c, .. } if c == cw);
     if counterweights_first {
-        pick(&|k| !spring(k), &relative)
+        worst_cw
+            .and_then(|cw| pick(&|k| of_cw(k, cw), &relative))
+            .or_else(|| pick(&|k| !spring(k), &relative))
             .or_else(|| {
                 pick(&|k| spring(k) && score[k] > 1e-9, &|k| {
                     score[k] * relative(k)
@@ -287,6 +297,10 @@ fn branching_coordinate(
 /// Every physical point of the box stays inside (the ranges hold the relaxation's points).
 fn tighten(problem: &VariantProblem, mut root: NodeBox, options: &BranchOptions) -> NodeBox {
     let coords = coordinates(problem);
+    if problem.counterweights.is_empty() {
+        return root;
+    }
+    let base = RelaxationBase::new(problem, &[], Objective::Minimax);
     for (k, c) in coords.iter().enumerate() {
         let column = match *c {
             Coordinate::Mass { cw } => problem.counterweights[cw].column,
@@ -294,7 +308,7 @@ fn tighten(problem: &VariantProblem, mut root: NodeBox, options: &BranchOptions)
             _ => continue,
         };
         if let Some([lo, hi]) =
-            crate::relaxation::lifted_range(problem, Some(&root), column, options.solver_iterations)
+            base.lifted_range(problem, Some(&root), column, options.solver_iterations)
         {
             let r = &mut root.ranges[k];
             if lo > hi {
@@ -319,6 +333,9 @@ pub fn branch_and_bound(
     incumbent: Option<Design>,
 ) -> Result<Verdict, String> {
     let root = tighten(problem, NodeBox::root(problem)?, options);
+    let base = RelaxationBase::new(problem, tasks, objective);
+    // Peak rows found active in any box so far: every later box starts with them.
+    let mut active = Vec::new();
     let coords = coordinates(problem);
     let scale = tasks
         .iter()
@@ -331,8 +348,8 @@ pub fn branch_and_bound(
     let mut order = 0;
     if let Some(o) = bound_box(
         problem,
-        tasks,
-        objective,
+        &base,
+        &mut active,
         options,
         root.clone(),
         f64::NEG_INFINITY,
@@ -394,8 +411,20 @@ pub fn branch_and_bound(
                     .expect("open is not empty")
             });
         let current = open.swap_remove(at);
-        if let Some(z) = &current.z
-            && let Some(d) = design_at(problem, b, tasks, objective, z, scale)
+        // A design is sought where it could improve on the best one: where the relaxed point's
+        // true objective is below it (the refinement only moves to feasibility nearby).
+        let promising = |z: &DVector<f64>| {
+            best.as_ref().is_none_or(|d| {
+                let (_, value, _) =
+                    merit(problem, tasks, objective, &project_fixed(problem, z), scale);
+                value < d.value
+            })
+        };
+        let found = match &current.z {
+            Some(z) if promising(z) => design_at(problem, b, tasks, objective, z, scale),
+            _ => None,
+        };
+        if let Some(d) = found
             && best.as_ref().is_none_or(|bd| d.value < bd.value)
         {
             best = Some(d);
@@ -418,8 +447,8 @@ pub fn branch_and_bound(
             order += 1;
             let Some(o) = bound_box(
                 problem,
-                tasks,
-                objective,
+                &base,
+                &mut active,
                 options,
                 child,
                 current.bound,
