@@ -239,7 +239,9 @@ impl Built {
             .zip(&self.cw_vars)
             .map(|(c, vars)| {
                 let m = x[c.column];
-                if !(m > 0.0) || solution.x.len() <= vars.s_vars.iter().copied().max().unwrap_or(0)
+                if m.is_nan()
+                    || m <= 0.0
+                    || solution.x.len() <= vars.s_vars.iter().copied().max().unwrap_or(0)
                 {
                     return 0.0;
                 }

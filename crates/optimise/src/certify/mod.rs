@@ -157,7 +157,7 @@ fn design_at(
     let x = problem.lifted(&z);
     let accept = |springs: Vec<SpringValues>, x_full: DVector<f64>| -> Option<Design> {
         let cws = problem.cw_physical(&x_full);
-        if cws.iter().any(|c| !(c.mass > 0.0)) {
+        if cws.iter().any(|c| c.mass.is_nan() || c.mass <= 0.0) {
             return None;
         }
         let e = problem.evaluate(&cws, tasks);

@@ -221,7 +221,7 @@ pub fn describe(problem: &VariantProblem, c: Coordinate) -> String {
 /// is convex, a plane above all four corners is above `f` on the whole box).
 pub fn square_over_linear_planes(x: [f64; 2], m: [f64; 2]) -> Vec<[f64; 3]> {
     let f = |x: f64, m: f64| x * x / m;
-    if !(m[0] > 0.0) || x[0] > x[1] || m[0] > m[1] {
+    if m[0].is_nan() || m[0] <= 0.0 || x[0] > x[1] || m[0] > m[1] {
         return Vec::new();
     }
     let mut out = vec![[-x[0] * x[1] / m[0], (x[0] + x[1]) / m[0], 0.0]];

@@ -5,6 +5,7 @@
 //! crate's grid tables.
 
 use super::*;
+use crate::springs::realize_springs;
 use counterpoise_balance::{Catalogue, SearchOptions, catalogue_options, mechanism_energy};
 use counterpoise_balance::{realization_hints, search};
 use counterpoise_dynamics::evaluate_grid;
