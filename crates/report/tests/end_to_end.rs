@@ -122,6 +122,7 @@ fn feasible(id: usize, labels: &[&str], class: Class, e: Evaluation) -> VariantR
         lower_bound: Some(12.4),
         gap: Some(0.008),
         iterations: Some(2),
+        boxes: Some(0),
         message: None,
     });
     v
