@@ -150,8 +150,11 @@ fn the_hybrid_optimum_known_in_closed_form_is_reached_from_every_start() {
         2,
         0xdead_beef,
     ] {
+        // The corner planes close the last 0.2 % slowly here (about 1,000 boxes of a small
+        // problem, under a second): a larger box limit than the default.
         let options = OptimiseOptions {
             start_seed: seed,
+            max_nodes: 4000,
             ..OptimiseOptions::default()
         };
         let v = run(&json, &["m1", "K10"], &options);
