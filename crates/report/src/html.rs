@@ -309,8 +309,8 @@ fn ranking_note(r: &RunResults) -> String {
         return String::new();
     };
     let mut s = format!(
-        "<p class=\"note\">Variants are ordered by ΔQTR, then ΔQIT, then ΔR, each compared at a resolution of {} percentage points (values closer than that tie, so dynamically identical spring-only variants are separated by ΔR). {}. Class rank is the position within the class in this order. SB<i>n</i> names the variant ranked <i>n</i>-th.",
-        info.resolution,
+        "<p class=\"note\">{} {}. Class rank is the position within the class in this order. SB<i>n</i> names the variant ranked <i>n</i>-th.",
+        esc(&r.ranking_rule().unwrap_or_default()),
         esc(&capitalise(&info.tie_break))
     );
     if info.tie_groups.is_empty() {
@@ -337,7 +337,7 @@ fn ranking_note(r: &RunResults) -> String {
     s
 }
 
-fn capitalise(s: &str) -> String {
+pub(crate) fn capitalise(s: &str) -> String {
     let mut c = s.chars();
     match c.next() {
         Some(f) => f.to_uppercase().chain(c).collect(),

@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use crate::format::{escape_md as esc, fixed};
+use crate::format::escape_md as esc;
 use crate::results::RunResults;
 use crate::tables::{self, Table};
 
@@ -66,11 +66,9 @@ pub fn render(r: &RunResults) -> String {
     if let Some(info) = &r.ranking {
         let _ = writeln!(
             s,
-            "Lexicographic by ΔQTR, ΔQIT, ΔR at a resolution of {} percentage points. {}.\n",
-            fixed(info.resolution, 4)
-                .trim_end_matches('0')
-                .trim_end_matches('.'),
-            esc(&info.tie_break)
+            "{} {}.\n",
+            esc(&r.ranking_rule().unwrap_or_default()),
+            esc(&crate::html::capitalise(&info.tie_break))
         );
     }
     s.push_str(

@@ -631,8 +631,8 @@ impl RunResults {
         self.ranking = Some(RankingInfo {
             resolution: options.resolution,
             criteria: vec!["dqtr".into(), "dqit".into(), "dr".into()],
-            tie_break: "variants tied on all three criteria at the resolution are ordered by \
-                        their element labels (ascending), then by enumeration index"
+            tie_break: "variants in the same cell on all three criteria are ordered by their \
+                        element labels (ascending)"
                 .into(),
             tie_groups: ranking
                 .tie_groups
@@ -661,6 +661,43 @@ impl RunResults {
             self.variants.iter().filter(|v| v.rank.is_some()).collect();
         v.sort_by_key(|v| v.rank);
         v
+    }
+
+    /// The ranking rule in words, as the reports state it (`None` before `finalize`).
+    ///
+    /// `counterpoise report DIR` re-renders a results.json without ranking it again, and one
+    /// written by an earlier version holds an order made by chaining values closer than the
+    /// resolution ([`crate::ranking`] says why that was replaced). So the rule stated is the
+    /// one the stored order follows: the grid rule when every rank is in cell order (always
+    /// for results this version writes), else the chained rule, with what it can do.
+    pub fn ranking_rule(&self) -> Option<String> {
+        let info = self.ranking.as_ref()?;
+        let res = info.resolution;
+        let cells = |v: &VariantRecord| -> [f64; 3] {
+            [v.dqtr, v.dqit, v.dr].map(|x| crate::ranking::cell(x.unwrap_or(0.0), res))
+        };
+        let ranked = self.ranked();
+        let follows_grid = ranked.windows(2).all(|w| {
+            let (a, b) = (cells(w[0]), cells(w[1]));
+            a.iter()
+                .zip(&b)
+                .fold(std::cmp::Ordering::Equal, |o, (x, y)| {
+                    o.then_with(|| x.total_cmp(y))
+                })
+                .is_le()
+        });
+        Some(if follows_grid {
+            crate::ranking::rule_text(res)
+        } else {
+            format!(
+                "Variants are ordered by ΔQTR, then ΔQIT, then ΔR, lower first, by the rule of \
+                 the version that wrote these results: values whose gaps to their neighbours \
+                 are below {res} percentage points were chained into one tie group, so a \
+                 variant can be ranked above one that is better by more than {res} percentage \
+                 points on the criterion that decides them. Run again to rank by the current \
+                 rule (values rounded to a fixed grid)."
+            )
+        })
     }
 
     /// The best variant of each class that has one (after `finalize`), in class order.

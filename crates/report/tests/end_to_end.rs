@@ -602,6 +602,33 @@ fn full_ties_are_flagged_and_listed() {
 }
 
 #[test]
+fn reports_state_the_rule_the_stored_order_follows() {
+    // After `finalize` the order is in cell order and the reports state the grid rule.
+    let mut r = full();
+    let grid = "rounded to the nearest multiple of 0.01 percentage points";
+    assert!(r.ranking_rule().unwrap().contains(grid));
+    assert!(counterpoise_report::html::render(&r).contains(grid));
+    assert!(counterpoise_report::markdown::render(&r).contains(grid));
+    // A results.json of an earlier version can hold an order the grid does not give: here
+    // SB1 (ΔQTR −65 %) and SB3 (m6 + K43, ΔQTR (15 − 40)/40 = −62.5 %) swapped, so −62.5 is
+    // ranked above −65. `report DIR` re-renders such a file without re-ranking it, so the
+    // reports must not claim the grid rule for it.
+    let (first, third) = (r.variant(10).unwrap().rank, r.variant(20).unwrap().rank);
+    assert_eq!((first, third), (Some(1), Some(3)));
+    for v in &mut r.variants {
+        v.rank = match v.rank {
+            Some(1) => Some(3),
+            Some(3) => Some(1),
+            other => other,
+        };
+    }
+    let rule = r.ranking_rule().unwrap();
+    assert!(!rule.contains(grid), "{rule}");
+    assert!(rule.contains("chained into one tie group"), "{rule}");
+    assert!(counterpoise_report::html::render(&r).contains("chained into one tie group"));
+}
+
+#[test]
 fn critical_tasks_cover_ub_and_best_variants_once() {
     let r = full();
     let tasks = r.critical_tasks();

@@ -71,13 +71,25 @@ fn class_names_are_the_results_json_schema() {
 }
 
 #[test]
-fn compare_at_is_strict_at_the_resolution() {
-    // 1.5 − 1.0 = 0.5 exactly: a gap of one resolution is a difference, below it a tie.
+fn compare_at_compares_cells_of_the_resolution_grid() {
+    // Resolution 0.5: a value's cell is round(v / 0.5), half-way away from zero. Worked by
+    // hand with values exact in binary:
+    // 1.0 → 2, 1.2 → 2.4 → 2: same cell, a tie.
+    assert_eq!(compare_at(1.0, 1.2, 0.5), Ordering::Equal);
+    // 1.0 → 2, 1.5 → 3: one resolution apart, a difference, either way round.
     assert_eq!(compare_at(1.0, 1.5, 0.5), Ordering::Less);
     assert_eq!(compare_at(1.5, 1.0, 0.5), Ordering::Greater);
-    assert_eq!(compare_at(1.0, 1.25, 0.5), Ordering::Equal);
-    assert_eq!(compare_at(1.25, 1.0, 0.5), Ordering::Equal);
+    // 1.2 → 2 and 1.3 → 2.6 → 3: only 0.1 apart but on either side of 1.25, the half-way
+    // point between 1.0 and 1.5, so the lower value wins (the stated price of a fixed grid).
+    assert_eq!(compare_at(1.2, 1.3, 0.5), Ordering::Less);
+    // 0.75 → 1.5 → 2 (away from zero), the same cell as 1.0; likewise −0.75 and −1.0 (−2).
+    assert_eq!(compare_at(0.75, 1.0, 0.5), Ordering::Equal);
+    assert_eq!(compare_at(-0.75, -1.0, 0.5), Ordering::Equal);
+    // −0.2 → −0.4 → −0 and 0.2 → 0.4 → 0: the zero cell is one cell, whatever the sign.
+    assert_eq!(compare_at(-0.2, 0.2, 0.5), Ordering::Equal);
+    // Resolution 0: exact.
     assert_eq!(compare_at(2.0, 2.0, 0.0), Ordering::Equal);
+    assert_eq!(compare_at(2.0, 2.0 + 1e-15, 0.0), Ordering::Less);
 }
 
 #[test]
