@@ -181,8 +181,9 @@ fn run_writes_every_output_and_report_regenerates_them() {
         "header and one row each"
     );
 
-    // The torque charts draw the unbalanced robot and, per class, the variant ranked first in
-    // it: every class present among the feasible variants has its winner in every chart.
+    // The torque charts draw the unbalanced robot, per class the variant ranked first in it
+    // (every class present among the feasible variants has its winner in every chart), and
+    // the recommended variants.
     let winners: BTreeSet<u64> = feasible
         .iter()
         .filter(|v| v["class_rank"] == 1)
@@ -193,6 +194,11 @@ fn run_writes_every_output_and_report_regenerates_them() {
         .map(|v| v["class"].as_str().unwrap())
         .collect();
     assert_eq!(winners.len(), classes.len(), "one winner per class");
+    let decision = &results["decision"];
+    let recommended = std::iter::once(&decision["overall"])
+        .chain(decision["classes"].as_array().unwrap())
+        .map(|r| r["chosen"].as_u64().unwrap());
+    let winners: BTreeSet<u64> = winners.iter().copied().chain(recommended).collect();
     let charts = results["torque_charts"].as_array().unwrap();
     assert!(!charts.is_empty());
     for chart in charts {

@@ -424,15 +424,20 @@ pub fn finish(
     results.moving_mass = Some(model.bodies.iter().map(|b| b.mass).sum());
     timer.time("Phase 3: ranking, torque curves, path", || {
         results.finalize(&study.ranking)?;
-        let mechanisms = best_mechanisms(model, &results, optimised)?;
-        add_torque_charts(model, &mut results, &mechanisms)?;
-        let mut path_configurations = Vec::new();
-        if !model.paths.is_empty() {
-            let (simulation, q) = path_simulation(model, &mechanisms, 0)?;
-            results.path = Some(simulation);
-            path_configurations = q;
-        }
+        // The recommendation reads the practical figures, and the charts show it: figures
+        // first, then the decision, then the curves of the variants it names.
+        let path_configurations = if model.paths.is_empty() {
+            Vec::new()
+        } else {
+            path_configurations(model, 0)?
+        };
         add_practical_figures(model, &mut results, path_configurations)?;
+        results.finalize(&study.ranking)?;
+        let mechanisms = shown_mechanisms(model, &results, optimised)?;
+        add_torque_charts(model, &mut results, &mechanisms)?;
+        if !model.paths.is_empty() {
+            results.path = Some(path_simulation(model, &mechanisms, 0)?.0);
+        }
         results.finalize(&study.ranking)?;
         Ok(())
     })?;
@@ -698,27 +703,28 @@ fn dynamics_variant(model: &Model, opt: &OptimisedRecord) -> Result<Variant> {
     Ok(v)
 }
 
-/// The unbalanced robot and the best variant of each class as parameter columns, with their
-/// labels (`UB`, then display names) and variant ids.
+/// The unbalanced robot and the variants the report shows (the best-ranked and the
+/// recommended of each class, [`RunResults::shown_variants`]) as parameter columns, with their
+/// labels (`UB`, then `SB6 (K42 + K43), recommended`-style names) and variant ids.
 struct Mechanisms {
     params: ParameterSet,
     labels: Vec<(String, Option<usize>)>,
 }
 
-fn best_mechanisms(
+fn shown_mechanisms(
     model: &Model,
     results: &RunResults,
     optimised: &[OptimisedRecord],
 ) -> Result<Mechanisms> {
     let mut variants = vec![Variant::default()];
     let mut labels = vec![("UB".to_string(), None)];
-    for v in results.best_per_class() {
+    for v in results.shown_variants() {
         let label = v.label();
         let Some(opt) = optimised.iter().find(|o| o.label() == label) else {
             continue;
         };
         variants.push(dynamics_variant(model, opt)?);
-        labels.push((v.display_name(), Some(v.id)));
+        labels.push((results.shown_label(v), Some(v.id)));
     }
     Ok(Mechanisms {
         params: ParameterSet::from_variants(model, &variants)?,
@@ -731,6 +737,16 @@ const PATH_SAMPLES_PER_SEGMENT: usize = 60;
 /// How much the quasi-static run stretches the path's durations: velocities scale by 1e-6 and
 /// the inertial torques by 1e-12, far below anything a report shows.
 const STATIC_STRETCH: f64 = 1e6;
+
+/// The configurations along path `index`, sampled as [`path_simulation`] samples them (they
+/// are kinematics, the same for every mechanism): where the practical figures take the springs'
+/// peaks, needed before the simulation because the recommendation reads those figures.
+fn path_configurations(model: &Model, index: usize) -> Result<Vec<Vec<f64>>> {
+    let params = ParameterSet::from_variants(model, &[Variant::default()])?;
+    let series =
+        counterpoise_dynamics::path_series(model, &params, 0, index, PATH_SAMPLES_PER_SEGMENT)?;
+    Ok(series.q)
+}
 
 /// The paper's Sec. 3.3 simulation along path `index`: the timed cycle, and the same path
 /// traversed quasi-statically (static torques).
@@ -895,8 +911,9 @@ fn add_practical_figures(
     Ok(())
 }
 
-/// Torque curves (paper Fig. 10-style) of the unbalanced robot and the best variant of each
-/// class, on the critical RMS and peak tasks of each of them.
+/// Torque curves (paper Fig. 10-style) of the unbalanced robot and the shown variants (the
+/// best-ranked and the recommended of each class), on the critical RMS and peak tasks of each
+/// of them.
 fn add_torque_charts(model: &Model, results: &mut RunResults, m: &Mechanisms) -> Result<()> {
     let (params, labels) = (&m.params, &m.labels);
     let columns = labels.len();

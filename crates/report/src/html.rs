@@ -30,6 +30,8 @@ th { background: var(--band); font-weight: 600; vertical-align: bottom; }
 td.n, th.n { text-align: right; }
 td.n { white-space: nowrap; }
 tr.g td { border-top: 2px solid #b9c2c9; }
+tr.rec td { background: #fff4cc; }
+tr.rec td:first-child { box-shadow: inset 4px 0 0 #d99a00; }
 table.kv th { display: none; }
 table.kv td:first-child { color: var(--muted); padding-right: 18px; }
 .cols { display: flex; flex-wrap: wrap; gap: 8px 40px; align-items: flex-start; }
@@ -133,7 +135,7 @@ pub fn render(r: &RunResults) -> String {
     if r.torque_charts.is_empty() {
         h.push_str("<h2>Torque curves</h2><p class=\"muted\">No torque curves were recorded.</p>");
     } else {
-        h.push_str("<h2>Motor torques on the critical tasks</h2><p class=\"note\">Unbalanced robot (dashed grey) and the best-ranked variant of each class: blue circles counterweights only, green squares springs only, orange triangles hybrid; coinciding curves differ by dash pattern.</p>");
+        h.push_str("<h2>Motor torques on the critical tasks</h2><p class=\"note\">Unbalanced robot (dashed grey), the best-ranked variant of each class and, where different, the recommended ones (named “recommended”): blue circles counterweights only, green squares springs only, orange triangles hybrid; curves of one class and coinciding curves differ by dash pattern.</p>");
         push_charts(&mut h, &charts, Section::Torque);
     }
 
@@ -333,8 +335,27 @@ fn ranking_note(r: &RunResults) -> String {
             esc(&groups.join("; "))
         );
     }
+    let names = recommended_names(r);
+    if !names.is_empty() {
+        let _ = write!(
+            s,
+            " Highlighted rows, here and in the tables below: the recommended variants ({}).",
+            esc(&names)
+        );
+    }
     s.push_str("</p>");
     s
+}
+
+/// The recommended variants' names, `SB6, SB37, SB44`, best rank first.
+pub(crate) fn recommended_names(r: &RunResults) -> String {
+    let ids = r.recommended_ids();
+    r.ranked()
+        .iter()
+        .filter(|v| ids.contains(&v.id))
+        .filter_map(|v| v.name.clone())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 pub(crate) fn capitalise(s: &str) -> String {
@@ -371,8 +392,14 @@ fn table(t: &Table, class: &str) -> String {
         }
     }
     s.push_str("</tr></thead><tbody>");
-    for (row, &group) in t.rows.iter().zip(&t.group_starts) {
-        s.push_str(if group { "<tr class=\"g\">" } else { "<tr>" });
+    for (k, (row, &group)) in t.rows.iter().zip(&t.group_starts).enumerate() {
+        let rec = t.highlighted.get(k).copied().unwrap_or(false);
+        s.push_str(match (group, rec) {
+            (true, true) => "<tr class=\"g rec\">",
+            (true, false) => "<tr class=\"g\">",
+            (false, true) => "<tr class=\"rec\">",
+            (false, false) => "<tr>",
+        });
         for cell in row {
             if cell.numeric {
                 let _ = write!(s, "<td class=\"n\">{}</td>", esc(&cell.text));

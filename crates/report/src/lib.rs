@@ -31,7 +31,8 @@
 //! results.finalize(&RankingOptions::default())?;        // ΔQTR = −60 %, rank 1
 //! assert_eq!(results.variants[0].dqtr, Some(-60.0));
 //! // Torque curves: for each `results.critical_tasks()`, compute the series of UB and of
-//! // `results.best_per_class()`, push a `TorqueChart`, then `finalize` again (idempotent).
+//! // `results.shown_variants()` (best-ranked and recommended), push a `TorqueChart`, then
+//! // `finalize` again (idempotent).
 //! let dir = std::env::temp_dir().join(format!("cp-report-doc-{}", std::process::id()));
 //! write_outputs(&dir, &results)?;                        // results.json, report.html, …
 //! print!("{}", text::summary(&results));                  // the run command's stdout table

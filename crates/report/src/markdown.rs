@@ -70,6 +70,14 @@ pub fn render(r: &RunResults) -> String {
             esc(&r.ranking_rule().unwrap_or_default()),
             esc(&crate::html::capitalise(&info.tie_break))
         );
+        let names = crate::html::recommended_names(r);
+        if !names.is_empty() {
+            let _ = writeln!(
+                s,
+                "Names in bold, here and in the tables below: the recommended variants ({}).\n",
+                esc(&names)
+            );
+        }
     }
     s.push_str(
         "Objective: the value the optimiser minimised at the returned parameters (RMS*, Eq. 11, \
@@ -149,10 +157,18 @@ fn table(s: &mut String, t: &Table) {
         s.push_str(if n { " ---: |" } else { " --- |" });
     }
     s.push('\n');
-    for row in &t.rows {
+    // Markdown has no row colour: a recommended variant's name is in bold (its "Variant"
+    // cell, or the row's first), which keeps the numbers plain for anyone reading them back.
+    let name_column = t.header.iter().position(|h| h == "Variant").unwrap_or(0);
+    for (k, row) in t.rows.iter().enumerate() {
+        let rec = t.highlighted.get(k).copied().unwrap_or(false);
         s.push('|');
-        for c in row {
-            let _ = write!(s, " {} |", esc(&c.text));
+        for (column, c) in row.iter().enumerate() {
+            if rec && column == name_column && !c.text.is_empty() {
+                let _ = write!(s, " **{}** |", esc(&c.text));
+            } else {
+                let _ = write!(s, " {} |", esc(&c.text));
+            }
         }
         s.push('\n');
     }

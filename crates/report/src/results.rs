@@ -5,8 +5,9 @@
 //! metadata, the case echo, the unbalanced indicators, every variant examined with its status and,
 //! for feasible ones, physical parameters and re-evaluated indicators, then torque curves and an
 //! optional path simulation — and calls [`RunResults::finalize`], which computes the Phase 3
-//! fields (ΔQTR, ΔQIT, ΔR, ranks, counts, tables). `finalize` is idempotent: call it, ask
-//! [`RunResults::best_per_class`] which variants need torque curves, add them, call it again.
+//! fields (ΔQTR, ΔQIT, ΔR, ranks, counts, tables). `finalize` is idempotent: call it, add the
+//! practical figures, call it again (the recommendation reads them), ask
+//! [`RunResults::shown_variants`] which variants need torque curves, add them, call it again.
 //!
 //! Units are SI throughout the document (kg, m, N/m, N, N·m, s, rad); the reports convert to
 //! the paper's display units (mm, N/mm). Changes that rename or remove fields bump
@@ -712,14 +713,70 @@ impl RunResults {
             .collect()
     }
 
+    /// Ids of the recommended variants (after `finalize`): the overall recommendation, then
+    /// each class's, each once.
+    pub fn recommended_ids(&self) -> Vec<usize> {
+        let mut ids: Vec<usize> = Vec::new();
+        if let Some(d) = &self.decision {
+            for rec in d.overall.iter().chain(&d.classes) {
+                if !ids.contains(&rec.chosen) {
+                    ids.push(rec.chosen);
+                }
+            }
+        }
+        ids
+    }
+
+    /// The variants the torque curves and the path simulation show (after `finalize`): per
+    /// class, the best-ranked one and, where different, the class's recommendation; then the
+    /// overall recommendation if no class brought it. The report leads with the
+    /// recommendation, so the design one would build must have its curves; the best-ranked
+    /// stays beside it as the paper's reference. Call it after the practical figures are in
+    /// (the decision reads them) and `finalize` again.
+    pub fn shown_variants(&self) -> Vec<&VariantRecord> {
+        let decision = self.decision.as_ref();
+        let class_choice = |c: Class| {
+            decision
+                .and_then(|d| d.classes.iter().find(|r| r.class == Some(c)))
+                .and_then(|r| self.variant(r.chosen))
+        };
+        let overall = decision
+            .and_then(|d| d.overall.as_ref())
+            .and_then(|r| self.variant(r.chosen));
+        let candidates = self
+            .best_per_class()
+            .into_iter()
+            .flat_map(|best| [Some(best), class_choice(best.class)])
+            .chain([overall])
+            .flatten();
+        let mut out: Vec<&VariantRecord> = Vec::new();
+        for v in candidates {
+            if v.rank.is_some() && !out.iter().any(|o| o.id == v.id) {
+                out.push(v);
+            }
+        }
+        out
+    }
+
+    /// The name of a shown variant in chart legends and the path table: its display name
+    /// (`SB6 (K42 + K43)`), with `, recommended` when it is one of the recommendations.
+    pub fn shown_label(&self, v: &VariantRecord) -> String {
+        if self.recommended_ids().contains(&v.id) {
+            format!("{}, recommended", v.display_name())
+        } else {
+            v.display_name()
+        }
+    }
+
     /// The (actuator, task) pairs whose torque curves the report should show: the critical RMS
-    /// and peak tasks of every actuator of the unbalanced robot and of the best variant of each
-    /// class (after `finalize`), each pair once, with every reason it is critical. In actuator
-    /// order, then in order of first mention.
+    /// and peak tasks of every actuator of the unbalanced robot and of every shown variant
+    /// ([`RunResults::shown_variants`]: the best-ranked and the recommended of each class)
+    /// (after `finalize`), each pair once, with every reason it is critical. In actuator order,
+    /// then in order of first mention.
     pub fn critical_tasks(&self) -> Vec<CriticalTask> {
         let mut out: Vec<CriticalTask> = Vec::new();
         let mut mechanisms = vec![("UB".to_string(), &self.unbalanced)];
-        for v in self.best_per_class() {
+        for v in self.shown_variants() {
             if let (Some(name), Some(e)) = (&v.name, &v.evaluation) {
                 mechanisms.push((name.clone(), e));
             }

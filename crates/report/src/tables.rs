@@ -40,12 +40,15 @@ impl Cell {
     }
 }
 
-/// A table: header, rows, and which rows start a visual group (e.g. a new variant).
+/// A table: header, rows, which rows start a visual group (e.g. a new variant) and which rows
+/// are highlighted (those of a recommended variant, so the design to build stands out in
+/// every list of variants).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Table {
     pub header: Vec<String>,
     pub rows: Vec<Vec<Cell>>,
     pub group_starts: Vec<bool>,
+    pub highlighted: Vec<bool>,
 }
 
 impl Table {
@@ -54,12 +57,17 @@ impl Table {
             header: header.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),
             group_starts: Vec::new(),
+            highlighted: Vec::new(),
         }
     }
     fn push(&mut self, row: Vec<Cell>, group_start: bool) {
+        self.push_marked(row, group_start, false);
+    }
+    fn push_marked(&mut self, row: Vec<Cell>, group_start: bool, highlighted: bool) {
         debug_assert_eq!(row.len(), self.header.len());
         self.rows.push(row);
         self.group_starts.push(group_start);
+        self.highlighted.push(highlighted);
     }
 
     /// Removes columns that are empty in every row (e.g. the optimiser's columns when it
@@ -257,11 +265,12 @@ pub fn ranking(r: &RunResults) -> Table {
         "Gap",
         "Note",
     ]);
+    let recommended = r.recommended_ids();
     for v in r.ranked() {
         let eval = v.evaluation.as_ref();
         let optim = v.optimiser.as_ref();
         let practical = v.practical.as_ref();
-        t.push(
+        t.push_marked(
             vec![
                 Cell::num(v.rank.map(|x| x.to_string()).unwrap_or_default()),
                 Cell::text(v.name.clone().unwrap_or_default()),
@@ -284,6 +293,7 @@ pub fn ranking(r: &RunResults) -> Table {
                 }),
             ],
             false,
+            recommended.contains(&v.id),
         );
     }
     t.without_empty_columns()
@@ -296,14 +306,16 @@ pub fn parameters(r: &RunResults) -> Table {
         "Variant", "Element", "Bodies", "K [N/mm]", "a [mm]", "α [rad]", "b [mm]", "β [rad]",
         "m [kg]", "r [mm]", "φ [rad]",
     ]);
+    let recommended = r.recommended_ids();
     for v in r.ranked() {
         let Some(p) = &v.parameters else { continue };
+        let mark = recommended.contains(&v.id);
         let mut first = true;
         let name = v.name.clone().unwrap_or_default();
         for s in &p.springs {
             let (a, alpha) = vector_cells(s.anchor_a, s.plane);
             let (b, beta) = vector_cells(s.anchor_b, s.plane);
-            t.push(
+            t.push_marked(
                 vec![
                     Cell::text(if first { name.clone() } else { String::new() }),
                     Cell::text(&s.label),
@@ -318,12 +330,13 @@ pub fn parameters(r: &RunResults) -> Table {
                     Cell::empty(),
                 ],
                 first,
+                mark,
             );
             first = false;
         }
         for c in &p.counterweights {
             let (rr, phi) = vector_cells(c.offset, c.plane);
-            t.push(
+            t.push_marked(
                 vec![
                     Cell::text(if first { name.clone() } else { String::new() }),
                     Cell::text(&c.label),
@@ -338,6 +351,7 @@ pub fn parameters(r: &RunResults) -> Table {
                     Cell::num(phi),
                 ],
                 first,
+                mark,
             );
             first = false;
         }
@@ -490,6 +504,7 @@ pub fn path_table(p: &PathSimulation) -> Table {
         header,
         rows: Vec::new(),
         group_starts: Vec::new(),
+        highlighted: Vec::new(),
     };
     for a in &p.actuators {
         for (stat, first) in [("RMS", true), ("|peak|", false)] {
@@ -677,6 +692,7 @@ pub fn practical(r: &RunResults) -> Table {
     let mut header = vec!["Rank", "Variant", "Elements", "Class"];
     header.extend(PRACTICAL_HEADER);
     let mut t = Table::new(&header);
+    let recommended = r.recommended_ids();
     for v in r.ranked() {
         let mut row = vec![
             Cell::num(v.rank.map(|x| x.to_string()).unwrap_or_default()),
@@ -685,7 +701,7 @@ pub fn practical(r: &RunResults) -> Table {
             Cell::text(v.class.name()),
         ];
         row.extend(practical_cells(v));
-        t.push(row, false);
+        t.push_marked(row, false, recommended.contains(&v.id));
     }
     t.without_empty_columns()
 }

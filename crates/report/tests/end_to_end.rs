@@ -491,7 +491,11 @@ fn writes_all_outputs_and_regenerates() {
         .take_while(|l| l.starts_with('|'))
         .collect();
     assert_eq!(ranking_rows.len(), 5, "{md}");
-    assert!(ranking_rows[0].starts_with("| 1 | SB1 | K42 + K43 |"));
+    // SB1 is the springs' and the overall recommendation: its name in bold.
+    assert!(
+        ranking_rows[0].starts_with("| 1 | **SB1** | K42 + K43 |"),
+        "{md}"
+    );
     assert!(md.contains("## Optimised parameters (Table 1)"));
     assert!(md.find("## Which variant to build").unwrap() < md.find("## Summary").unwrap());
     // 2 springs of 4535.2 N peak; 228.6 kg per counterweight, 2 of them = 457.2 kg = 38.5 %
@@ -707,9 +711,80 @@ fn aligned_columns_match_a_hand_layout() {
             ],
         ],
         group_starts: vec![false, false],
+        highlighted: vec![false, false],
     };
     assert_eq!(
         counterpoise_report::text::aligned(&t),
         "  Variant      ΔQTR  Note\n  m4          −5.00\n  K42 + K43  −63.20  tie\n"
+    );
+}
+
+#[test]
+fn charts_and_tables_follow_the_recommendation() {
+    // At a 5 pp tolerance the counterweights' recommendation is no longer their best-ranked
+    // variant. By hand: SB5 (m4 + m6: ΔQTR −40, ΔQIT −31.11) is within 5 pp of SB4 (m4 + m5:
+    // −45, −33.33); both add 457.2 kg; ΔR 0.00 against 23.76, so SB5. Springs: SB1 and SB2
+    // tie on mass, ΔR 1.18 and 2.35 are within 5, same parts and force, so the rank: SB1.
+    // Hybrid: SB3 alone. Overall: SB1 and SB2 add no mass, then as the springs: SB1.
+    let mut r = full();
+    r.redecide(5.0);
+    let name = |id: usize| r.variant(id).unwrap().name.clone().unwrap();
+    let mut recommended: Vec<String> = r.recommended_ids().into_iter().map(name).collect();
+    recommended.sort();
+    assert_eq!(recommended, ["SB1", "SB3", "SB5"]);
+    // Shown: per class (counterweights, springs, hybrid) the best-ranked, then the
+    // recommendation where different.
+    let shown: Vec<String> = r
+        .shown_variants()
+        .iter()
+        .map(|v| v.name.clone().unwrap())
+        .collect();
+    assert_eq!(shown, ["SB4", "SB5", "SB1", "SB3"]);
+    let labels: Vec<String> = r
+        .shown_variants()
+        .iter()
+        .map(|v| r.shown_label(v))
+        .collect();
+    assert_eq!(
+        labels,
+        [
+            "SB4 (m4 + m5)",
+            "SB5 (m4 + m6), recommended",
+            "SB1 (K42 + K43), recommended",
+            "SB3 (m6 + K43), recommended"
+        ]
+    );
+    // The recommended SB5 has its critical tasks among those to chart.
+    assert!(
+        r.critical_tasks()
+            .iter()
+            .any(|c| c.critical_for.iter().any(|w| w.ends_with("of SB5")))
+    );
+    // Highlighted rows: the ranking and practical tables one row per recommended variant,
+    // Table 1 one row per element of them (SB1: 2, SB3: 2, SB5: 2).
+    let html = counterpoise_report::html::render(&r);
+    let rows = |t: &counterpoise_report::tables::Table| -> Vec<String> {
+        t.rows
+            .iter()
+            .zip(&t.highlighted)
+            .filter(|(_, h)| **h)
+            .map(|(row, _)| row[1].text.clone())
+            .collect()
+    };
+    let ranking = counterpoise_report::tables::ranking(&r);
+    assert_eq!(rows(&ranking), ["SB1", "SB3", "SB5"]);
+    assert_eq!(
+        counterpoise_report::tables::parameters(&r)
+            .highlighted
+            .iter()
+            .filter(|h| **h)
+            .count(),
+        6
+    );
+    assert!(html.contains("the recommended variants (SB1, SB3, SB5)"));
+    assert_eq!(
+        html.matches("<tr class=\"rec\">").count() + html.matches("<tr class=\"g rec\">").count(),
+        3 + 3 + 6,
+        "ranking, practical figures, Table 1"
     );
 }
