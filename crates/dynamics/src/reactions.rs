@@ -37,6 +37,9 @@ use crate::regressor::{SampleRegressor, SpringFrame};
 
 /// Relative singular-value threshold of the pseudo-inverse.
 pub const RANK_TOLERANCE: f64 = 1e-10;
+/// Most iterations of an SVD of the reaction matrix: it converges in tens for any sane one,
+/// and nalgebra's default (no cap) never returns on a matrix it cannot reduce.
+const SVD_MAX_ITERATIONS: usize = 10_000;
 
 #[derive(Clone, Debug)]
 struct JointInfo {
@@ -215,8 +218,15 @@ impl ReactionSolver {
             .collect();
         let frames = solver.frames(mech, &scratch.pose);
         let a = solver.matrix(&frames, &kin);
-        if a.ncols() > 0 && a.nrows() > 0 {
-            let svd = a.clone().svd(false, false);
+        // A non-finite matrix (an overflow in the case's numbers) leaves the rank at 0 and the
+        // slow path: nalgebra's uncapped SVD never returns on a NaN.
+        if a.ncols() > 0
+            && a.nrows() > 0
+            && a.iter().all(|x| x.is_finite())
+            && let Some(svd) = a
+                .clone()
+                .try_svd(false, false, f64::EPSILON, SVD_MAX_ITERATIONS)
+        {
             let smax = svd.singular_values.max();
             solver.rank = svd
                 .singular_values
@@ -503,12 +513,21 @@ impl ReactionSolver {
             }
         }
         let a = DMatrix::from_column_slice(rows, k, &work.a);
-        let svd = a.svd(true, true);
-        let smax = svd.singular_values.max();
-        work.pinv = Some(
-            svd.pseudo_inverse(RANK_TOLERANCE * smax)
-                .unwrap_or_else(|_| DMatrix::zeros(k, rows)),
-        );
+        // Capped, and only on finite entries: nalgebra's SVD never returns on a NaN. Without
+        // one the reactions of the sample are NaN, not a made-up number.
+        let svd = a
+            .iter()
+            .all(|x| x.is_finite())
+            .then(|| a.try_svd(true, true, f64::EPSILON, SVD_MAX_ITERATIONS))
+            .flatten();
+        work.pinv = Some(match svd {
+            Some(svd) => {
+                let smax = svd.singular_values.max();
+                svd.pseudo_inverse(RANK_TOLERANCE * smax)
+                    .unwrap_or_else(|_| DMatrix::zeros(k, rows))
+            }
+            None => DMatrix::from_element(k, rows, f64::NAN),
+        });
     }
 
     /// Subtracts the actuator wrenches of actuator forces `qu` (`n × nc`, row-major) from the

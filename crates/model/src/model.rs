@@ -307,11 +307,12 @@ impl MechanismScale {
             .iter()
             .map(|b| {
                 let k = if b.mass > 0.0 {
-                    let largest = b
-                        .inertia_com
-                        .symmetric_eigenvalues()
-                        .iter()
-                        .fold(0.0f64, |m, x| m.max(*x));
+                    // The trace bounds the largest moment of a positive semi-definite
+                    // tensor: the fallback if the capped eigensolver gives up.
+                    let largest = crate::validate::principal_moments(&b.inertia_com)
+                        .map_or(b.inertia_com.trace(), |e| {
+                            e.iter().fold(0.0f64, |m, x| m.max(*x))
+                        });
                     (largest / b.mass).max(0.0).sqrt()
                 } else {
                     0.0

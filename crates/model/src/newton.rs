@@ -24,7 +24,18 @@ pub enum KinematicsError {
         value: f64,
         range: [f64; 2],
     },
+    #[error("{what} is not finite at q = {q:?} (a number of the case overflows)")]
+    NonFinite { what: &'static str, q: Vec<f64> },
+    #[error(
+        "the SVD of the actuator Jacobian did not converge in {iterations} iterations at q = {q:?}"
+    )]
+    SvdNotConverged { q: Vec<f64>, iterations: usize },
 }
+
+/// Most iterations of the SVD that checks the actuator Jacobian's condition number: it
+/// converges in a handful for the few coordinates a case has, so hitting the cap means the
+/// matrix is not a sane one (nalgebra's own default is no cap, which never returns on a NaN).
+const SVD_MAX_ITERATIONS: usize = 1000;
 
 /// Settings of the Newton solver.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,7 +67,19 @@ pub(crate) fn checked_lu(
     q: &DVector<f64>,
     max_condition: f64,
 ) -> Result<LU<f64, nalgebra::Dyn, nalgebra::Dyn>, KinematicsError> {
-    let singular = SVD::new(g.clone(), false, false).singular_values;
+    if !g.iter().all(|x| x.is_finite()) {
+        return Err(KinematicsError::NonFinite {
+            what: "the actuator Jacobian",
+            q: q.iter().copied().collect(),
+        });
+    }
+    let Some(svd) = SVD::try_new(g.clone(), false, false, f64::EPSILON, SVD_MAX_ITERATIONS) else {
+        return Err(KinematicsError::SvdNotConverged {
+            q: q.iter().copied().collect(),
+            iterations: SVD_MAX_ITERATIONS,
+        });
+    };
+    let singular = svd.singular_values;
     let (max, min) = singular
         .iter()
         .fold((0.0f64, f64::INFINITY), |(hi, lo), &s| {
@@ -111,7 +134,18 @@ impl Kinematics {
         let mut q = q_guess.clone();
         let mut residual = self.actuator_values(&q) - u_target;
         let mut iterations = 0;
-        while residual.amax() > tolerance {
+        loop {
+            // A NaN residual compares false with the tolerance: tested first, never taken for
+            // convergence.
+            if !residual.iter().all(|r| r.is_finite()) {
+                return Err(KinematicsError::NonFinite {
+                    what: "the actuator residual f(q) − u",
+                    q: q.iter().copied().collect(),
+                });
+            }
+            if residual.amax() <= tolerance {
+                break;
+            }
             if iterations == options.max_iterations {
                 return Err(KinematicsError::NotConverged {
                     iterations,
@@ -179,5 +213,54 @@ impl Kinematics {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn q() -> DVector<f64> {
+        DVector::from_vec(vec![0.1, 0.2])
+    }
+
+    /// A NaN or an infinity in the Jacobian is refused before the SVD (nalgebra's uncapped SVD
+    /// never returns on a NaN; this test would hang without the guard).
+    #[test]
+    fn a_non_finite_jacobian_is_refused_by_name() {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let g = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, bad, 1.0]);
+            match checked_lu(&g, &q(), 1e10) {
+                Err(KinematicsError::NonFinite { what, q }) => {
+                    assert_eq!(what, "the actuator Jacobian");
+                    assert_eq!(q, vec![0.1, 0.2]);
+                }
+                other => panic!("{bad}: {other:?}"),
+            }
+        }
+    }
+
+    /// Huge and tiny finite Jacobians: diag(1e308, 1e-308) has condition number 1e616, which
+    /// overflows to infinity (singular); diag(1e300, 1e300) is perfectly conditioned (1) and
+    /// factorises; the zero matrix is singular with condition ∞.
+    #[test]
+    fn extreme_finite_jacobians_are_decided() {
+        let wide = DMatrix::from_row_slice(2, 2, &[1e308, 0.0, 0.0, 1e-308]);
+        assert!(matches!(
+            checked_lu(&wide, &q(), 1e10),
+            Err(KinematicsError::Singular { condition, .. }) if condition == f64::INFINITY
+        ));
+        let big = DMatrix::from_row_slice(2, 2, &[1e300, 0.0, 0.0, 1e300]);
+        let lu = checked_lu(&big, &q(), 1e10).expect("condition 1");
+        let x = lu.solve(&DVector::from_vec(vec![2e300, 3e300])).unwrap();
+        assert!(
+            (x[0] - 2.0).abs() < 1e-12 && (x[1] - 3.0).abs() < 1e-12,
+            "{x}"
+        );
+        let zero = DMatrix::zeros(2, 2);
+        assert!(matches!(
+            checked_lu(&zero, &q(), 1e10),
+            Err(KinematicsError::Singular { condition, .. }) if condition == f64::INFINITY
+        ));
     }
 }

@@ -57,6 +57,50 @@ pub const MAX_DENSITY: f64 = 1e6;
 /// not tasks.
 pub const DURATION_RANGE: [f64; 2] = [1e-3, 1e6];
 
+/// Smallest norm of a vector used as a direction (a joint axis): shorter ones are refused.
+pub const MIN_AXIS_NORM: f64 = 1e-12;
+
+/// The unit vector along `v`, or why `v` gives no direction: it is zero, its norm is below
+/// [`MIN_AXIS_NORM`] (it underflows, or is too short to be told from zero), or its norm
+/// overflows (a component beyond about 1e154 squares to infinity; normalising by an infinite
+/// norm would give the zero vector, and the NaN that follows hangs an SVD). The components
+/// are known finite.
+pub fn unit_direction(v: &Vector3<f64>) -> Result<Vector3<f64>, String> {
+    let largest = v.amax();
+    let norm = v.norm();
+    if largest == 0.0 {
+        return Err("axis must not be zero".into());
+    }
+    if !norm.is_finite() {
+        return Err(format!(
+            "the axis's length overflows (a component of magnitude {}): a direction needs components of moderate size, e.g. [0, 0, 1]",
+            num(largest)
+        ));
+    }
+    if norm < MIN_AXIS_NORM {
+        return Err(format!(
+            "the axis's length {} is below {}: too short to give a direction (an axis must not be zero); scale it up, e.g. [0, 0, 1]",
+            num(norm.max(largest)),
+            num(MIN_AXIS_NORM)
+        ));
+    }
+    Ok(v / norm)
+}
+
+/// Most iterations of the symmetric eigensolver on a 3 × 3 inertia: it converges in a few for
+/// any finite tensor (nalgebra scales it first, so huge and subnormal entries are alike), and
+/// nalgebra's default is no cap at all.
+pub const EIGEN_MAX_ITERATIONS: usize = 1000;
+
+/// The principal moments of a symmetric 3 × 3 tensor, or `None` when the capped eigensolver
+/// does not converge (never seen for finite entries; the cap is there so that it cannot hang).
+pub fn principal_moments(m: &Matrix3<f64>) -> Option<Vector3<f64>> {
+    if !m.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    SymmetricEigen::try_new(*m, f64::EPSILON, EIGEN_MAX_ITERATIONS).map(|e| e.eigenvalues)
+}
+
 /// A number for a message: plain when moderate, in exponent form when huge or tiny (`1e308`
 /// is not printed as 309 digits).
 fn num(x: f64) -> String {
@@ -252,7 +296,15 @@ impl Validator {
         }
         let [ixx, iyy, izz, ixy, ixz, iyz] = *v;
         let m = Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
-        let eigenvalues = SymmetricEigen::new(m).eigenvalues;
+        let Some(eigenvalues) = principal_moments(&m) else {
+            self.invalid(
+                path,
+                format!(
+                    "the principal moments of this inertia could not be computed in {EIGEN_MAX_ITERATIONS} iterations"
+                ),
+            );
+            return None;
+        };
         let trace = m.trace();
         if eigenvalues.iter().any(|&e| e < -1e-9 * trace.abs()) {
             let mut e: Vec<f64> = eigenvalues.iter().copied().collect();
@@ -269,14 +321,18 @@ impl Validator {
         Some(m)
     }
 
-    /// A unit axis from a constant 3-vector; a zero vector is an error.
+    /// A unit axis from a constant 3-vector, checked by its norm (its components are only
+    /// known finite): a zero vector, a norm below [`MIN_AXIS_NORM`] (it underflows, or is too
+    /// short to give a direction) or one that overflows is an error naming the field.
     fn axis(&mut self, parser: &Parser, exprs: &[Expr; 3], path: &str) -> Option<Vector3<f64>> {
         let v = Vector3::from(parser.constant_vec(exprs, path, &mut self.errors)?);
-        if v.norm() < 1e-12 {
-            self.invalid(path, "axis must not be zero");
-            return None;
+        match unit_direction(&v) {
+            Ok(unit) => Some(unit),
+            Err(reason) => {
+                self.invalid(path, reason);
+                None
+            }
         }
-        Some(v.normalize())
     }
 
     fn interval(&mut self, v: [f64; 2], max: f64, unit: &str, path: &str) -> Option<[f64; 2]> {
@@ -1423,4 +1479,58 @@ fn task_paths(
         });
     }
     (v.errors.len() == start).then_some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Directions by hand: a 3-4-5 triangle gives (0.6, 0.8, 0) at any scale whose squares stay
+    /// finite; a norm that overflows (a component past √f64::MAX ≈ 1.34e154 squares to ∞) or
+    /// falls below MIN_AXIS_NORM (1e-308 squares to 0) is refused with the reason.
+    #[test]
+    fn unit_direction_is_checked_by_the_norm() {
+        for scale in [1.0, 1e-7, 3e150 / 3.0] {
+            let unit = unit_direction(&Vector3::new(3.0 * scale, 4.0 * scale, 0.0)).unwrap();
+            assert!(
+                (unit - Vector3::new(0.6, 0.8, 0.0)).amax() < 1e-15,
+                "{scale}: {unit}"
+            );
+        }
+        let err = unit_direction(&Vector3::new(0.0, -1e308, 0.0)).unwrap_err();
+        assert!(err.contains("overflows") && err.contains("1e308"), "{err}");
+        let err = unit_direction(&Vector3::new(1.4e154, 0.0, 0.0)).unwrap_err();
+        assert!(err.contains("overflows"), "{err}");
+        for tiny in [1e-308, 5e-324, -2.5e-320, 1e-13] {
+            let err = unit_direction(&Vector3::new(tiny, 0.0, 0.0)).unwrap_err();
+            assert!(err.contains("too short"), "{tiny}: {err}");
+        }
+        for zero in [[0.0, 0.0, 0.0], [-0.0, 0.0, -0.0]] {
+            let err = unit_direction(&Vector3::from(zero)).unwrap_err();
+            assert_eq!(err, "axis must not be zero");
+        }
+    }
+
+    /// [[2, 1, 0], [1, 2, 0], [0, 0, 5]] has eigenvalues 2 ± 1 and 5 (characteristic polynomial
+    /// by hand); the same tensor scaled by 1e300 or by 1e-310 (subnormal entries) has them
+    /// scaled; a NaN gives none (nalgebra's uncapped solver would not return).
+    #[test]
+    fn principal_moments_of_extreme_tensors() {
+        let m = Matrix3::new(2.0, 1.0, 0.0, 1.0, 2.0, 0.0, 0.0, 0.0, 5.0);
+        for scale in [1.0, 1e300, 1e-310] {
+            let mut e: Vec<f64> = principal_moments(&(m * scale))
+                .unwrap()
+                .iter()
+                .map(|x| x / scale)
+                .collect();
+            e.sort_by(f64::total_cmp);
+            let tol = if scale < 1e-300 { 1e-9 } else { 1e-12 };
+            for (got, want) in e.iter().zip([1.0, 3.0, 5.0]) {
+                assert!((got - want).abs() < tol, "{scale}: {e:?}");
+            }
+        }
+        let mut nan = m;
+        nan[(0, 1)] = f64::NAN;
+        assert_eq!(principal_moments(&nan), None);
+    }
 }

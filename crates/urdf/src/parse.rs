@@ -285,11 +285,13 @@ fn parse_joint(node: roxmltree::Node) -> Result<Joint, UrdfError> {
         .transpose()?
         .flatten()
         .unwrap_or([1.0, 0.0, 0.0]);
-    if kind != JointType::Fixed && axis.iter().all(|&a| a == 0.0) {
-        return Err(UrdfError::invalid(
-            format!("{axis_element}.xyz"),
-            "the axis is zero",
-        ));
+    // Checked by its norm, not only its components: a norm that overflows or underflows
+    // would normalise to zeros or NaN.
+    if kind != JointType::Fixed
+        && let Err(reason) =
+            counterpoise_model::validate::unit_direction(&nalgebra::Vector3::from(axis))
+    {
+        return Err(UrdfError::invalid(format!("{axis_element}.xyz"), reason));
     }
     let limit_element = format!("{element}.limit");
     let limit = match child(node, "limit") {

@@ -390,6 +390,38 @@ fn malformed_urdf_is_refused_naming_the_element() {
     ));
 }
 
+/// An axis is checked by its norm: `0 -1e308 0` is a finite vector whose norm overflows (its
+/// square is past f64::MAX), `0 -1e-308 0` one whose norm underflows to zero, and `0 0 0` has
+/// none; each is refused at the joint's `axis.xyz`.
+#[test]
+fn an_axis_whose_norm_overflows_or_vanishes_is_refused() {
+    let two = data("two_link.urdf");
+    let elbow = two.rfind("<axis xyz=\"0 -1 0\"/>").unwrap();
+    let with = |xyz: &str| {
+        format!(
+            "{}<axis xyz=\"{xyz}\"/>{}",
+            &two[..elbow],
+            &two[elbow + "<axis xyz=\"0 -1 0\"/>".len()..]
+        )
+    };
+    let huge = error_of(&with("0 -1e308 0"));
+    assert!(
+        huge.starts_with("joint `elbow`.axis.xyz: the axis's length overflows"),
+        "{huge}"
+    );
+    let tiny = error_of(&with("0 -1e-308 0"));
+    assert!(
+        tiny.starts_with("joint `elbow`.axis.xyz: the axis's length 1e-308 is below 1e-12"),
+        "{tiny}"
+    );
+    assert_eq!(
+        error_of(&with("0 0 0")),
+        "joint `elbow`.axis.xyz: axis must not be zero"
+    );
+    // A long axis whose norm stays finite is a direction like any other.
+    assert!(import(&with("0 -1e150 0"), &ImportOptions::default()).is_ok());
+}
+
 #[test]
 fn a_linear_mimic_follows_its_joint() {
     // The elbow mimics the shoulder twice over: link 2's angle is 3·shoulder.
