@@ -278,40 +278,196 @@ fn family_from_svd(
     }
 }
 
+/// Why a floating-point factorisation of a variant's system gave no usable answer. The search
+/// turns it into an `undecided` verdict with this text as the reason, never a panic.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum NumericError {
+    /// A coefficient of `A_S` or `b` is NaN or infinite (an extreme case, or an overflow on the
+    /// way): no factorisation of it means anything, so none is attempted.
+    #[error("a coefficient of the balance equations is not finite ({0})")]
+    NonFinite(&'static str),
+    /// The SVD stopped without converging, or produced a non-finite value from finite input.
+    #[error("the {solver} SVD failed ({reason})")]
+    Svd {
+        solver: &'static str,
+        reason: String,
+    },
+}
+
+/// Most implicit-shift QR sweeps nalgebra's SVD may take on an `n`-column problem before it is
+/// declared non-convergent (LAPACK's bound is 6·n² inner steps): with `max_niter = 0` it would
+/// loop for ever on a bidiagonal that never deflates, which a NaN produces.
+fn nalgebra_max_sweeps(n: usize) -> usize {
+    (6 * n * n).max(100)
+}
+
+/// `Err` unless every entry of `values` is finite; `what` names them in the error.
+fn ensure_finite<'a>(
+    values: impl IntoIterator<Item = &'a f64>,
+    what: &'static str,
+) -> Result<(), NumericError> {
+    if values.into_iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(NumericError::NonFinite(what))
+    }
+}
+
 /// The singular triplets of the column-scaled matrix by faer, every right singular vector
-/// included (σ = 0 past the rows); `Err` when the SVD fails.
+/// included (σ = 0 past the rows); `Err` when the SVD fails or returns a non-finite value.
 fn faer_triplets(
     matrix: &DMatrix<f64>,
     column_scale: &DVector<f64>,
-) -> Result<Vec<Triplet>, String> {
+) -> Result<Vec<Triplet>, NumericError> {
     let (rows, cols) = matrix.shape();
+    ensure_finite(matrix.iter(), "A_S")?;
+    ensure_finite(column_scale.iter(), "column scale")?;
+    if rows == 0 || cols == 0 {
+        return Ok(unit_triplets(rows, cols));
+    }
     let scaled = faer::Mat::from_fn(rows, cols, |i, j| matrix[(i, j)] / column_scale[j]);
+    let failed = |reason: String| NumericError::Svd {
+        solver: "faer",
+        reason,
+    };
     let svd = scaled
         .svd()
-        .map_err(|e| format!("the SVD did not converge ({e:?})"))?;
+        .map_err(|e| failed(format!("did not converge: {e:?}")))?;
     let (u, v) = (svd.U(), svd.V());
     let sigma: Vec<f64> = svd.S().column_vector().iter().copied().collect();
-    Ok((0..cols)
+    let triplets: Vec<Triplet> = (0..cols)
         .map(|k| {
             let s = sigma.get(k).copied().unwrap_or(0.0);
             let u_k = DVector::from_fn(rows, |i, _| if k < rows { u[(i, k)] } else { 0.0 });
             (s, u_k, DVector::from_fn(cols, |j, _| v[(j, k)]))
         })
-        .collect())
+        .collect();
+    triplets_finite(&triplets).map_err(|_| failed("a non-finite singular triplet".into()))?;
+    Ok(triplets)
+}
+
+/// The SVD of a matrix with no rows or no columns: every right vector `e_j` with σ = 0.
+fn unit_triplets(rows: usize, cols: usize) -> Vec<Triplet> {
+    (0..cols)
+        .map(|k| {
+            (
+                0.0,
+                DVector::zeros(rows),
+                DVector::from_fn(cols, |j, _| f64::from(j == k)),
+            )
+        })
+        .collect()
+}
+
+fn triplets_finite(triplets: &[Triplet]) -> Result<(), NumericError> {
+    for (s, u, v) in triplets {
+        ensure_finite(std::iter::once(s).chain(u.iter()).chain(v.iter()), "SVD")?;
+    }
+    Ok(())
 }
 
 /// The same triplets by nalgebra (padded so that the thin SVD yields every right vector).
-fn nalgebra_triplets(matrix: &DMatrix<f64>, column_scale: &DVector<f64>) -> Vec<Triplet> {
+///
+/// nalgebra's implicit-shift QR can produce a NaN from a *finite* matrix: the Householder
+/// bidiagonalisation of a rank-deficient `A_S` with zero columns and rows (a redundant element,
+/// such as a counterweight on a vertical-axis link, and the monomials other elements use) leaves
+/// a cascade of entries `1e-16, 1e-33, …, 1e-131` that its relative deflation test never
+/// discards, and the Wilkinson shift of such a block underflows to `0/0`. Its `svd` then panics
+/// while sorting ("Singular value was NaN"), and so does `try_svd`, which sorts too. So the
+/// factorisation is unordered with a sweep limit, checked for finiteness, and only then sorted
+/// exactly as `svd` sorts (the result is bit-identical wherever `svd` succeeds). When it fails,
+/// it is retried on the matrix without its zero rows and columns — an exact reduction: a zero
+/// column is a right singular vector `e_j` with σ = 0, and a zero row changes no product —
+/// which removes the underflowing cascade.
+fn nalgebra_triplets(
+    matrix: &DMatrix<f64>,
+    column_scale: &DVector<f64>,
+) -> Result<Vec<Triplet>, NumericError> {
     let (rows, cols) = matrix.shape();
+    ensure_finite(matrix.iter(), "A_S")?;
+    ensure_finite(column_scale.iter(), "column scale")?;
+    if rows == 0 || cols == 0 {
+        return Ok(unit_triplets(rows, cols));
+    }
     let mut scaled = DMatrix::zeros(rows.max(cols), cols);
     for j in 0..cols {
         let column = matrix.column(j) / column_scale[j];
         scaled.view_mut((0, j), (rows, 1)).copy_from(&column);
     }
-    let svd = scaled.svd(true, true);
-    let u = svd.u.expect("SVD computed with U");
-    let v_t = svd.v_t.expect("SVD computed with Vᵀ");
-    (0..svd.singular_values.len())
+    match nalgebra_svd(scaled, rows) {
+        Ok(triplets) => Ok(triplets),
+        Err(first) => {
+            let used_rows: Vec<usize> = (0..rows)
+                .filter(|&i| matrix.row(i).iter().any(|&v| v != 0.0))
+                .collect();
+            let used_cols: Vec<usize> = (0..cols)
+                .filter(|&j| matrix.column(j).iter().any(|&v| v != 0.0))
+                .collect();
+            if used_rows.len() == rows && used_cols.len() == cols {
+                return Err(first);
+            }
+            let (r, c) = (used_rows.len(), used_cols.len());
+            let mut reduced = DMatrix::zeros(r.max(c).max(1), c);
+            for (jj, &j) in used_cols.iter().enumerate() {
+                for (ii, &i) in used_rows.iter().enumerate() {
+                    reduced[(ii, jj)] = matrix[(i, j)] / column_scale[j];
+                }
+            }
+            let inner = if c == 0 {
+                Vec::new()
+            } else {
+                nalgebra_svd(reduced, r).map_err(|_| first)?
+            };
+            // Back to the full row and column spaces; the zero columns' unit vectors after.
+            let mut triplets: Vec<Triplet> = inner
+                .into_iter()
+                .map(|(s, u, v)| {
+                    let mut u_full = DVector::zeros(rows);
+                    for (ii, &i) in used_rows.iter().enumerate() {
+                        u_full[i] = u[ii];
+                    }
+                    let mut v_full = DVector::zeros(cols);
+                    for (jj, &j) in used_cols.iter().enumerate() {
+                        v_full[j] = v[jj];
+                    }
+                    (s, u_full, v_full)
+                })
+                .collect();
+            for j in (0..cols).filter(|j| !used_cols.contains(j)) {
+                triplets.push((
+                    0.0,
+                    DVector::zeros(rows),
+                    DVector::from_fn(cols, |k, _| f64::from(k == j)),
+                ));
+            }
+            Ok(triplets)
+        }
+    }
+}
+
+/// nalgebra's SVD of `padded` (at least as many rows as columns), whose first `rows` rows are
+/// the matrix: finite, sorted by decreasing σ, or `Err`.
+fn nalgebra_svd(padded: DMatrix<f64>, rows: usize) -> Result<Vec<Triplet>, NumericError> {
+    let failed = |reason: &str| NumericError::Svd {
+        solver: "nalgebra",
+        reason: reason.to_string(),
+    };
+    let sweeps = nalgebra_max_sweeps(padded.ncols());
+    // nalgebra's default tolerance, the one `svd` uses.
+    let eps = f64::EPSILON * 5.0;
+    let mut svd = nalgebra::linalg::SVD::try_new_unordered(padded, true, true, eps, sweeps)
+        .ok_or_else(|| failed("no convergence within the sweep limit"))?;
+    ensure_finite(svd.singular_values.iter(), "SVD").map_err(|_| failed("a NaN singular value"))?;
+    let (Some(u), Some(v_t)) = (&svd.u, &svd.v_t) else {
+        return Err(failed("singular vectors missing"));
+    };
+    ensure_finite(u.iter().chain(v_t.iter()), "SVD")
+        .map_err(|_| failed("a non-finite singular vector"))?;
+    svd.sort_by_singular_values();
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return Err(failed("singular vectors missing"));
+    };
+    Ok((0..svd.singular_values.len())
         .map(|k| {
             (
                 svd.singular_values[k],
@@ -319,27 +475,70 @@ fn nalgebra_triplets(matrix: &DMatrix<f64>, column_scale: &DVector<f64>) -> Vec<
                 v_t.row(k).transpose(),
             )
         })
-        .collect()
+        .collect())
+}
+
+/// A variant's system with no usable factorisation: inconsistent, rank 0, no free direction,
+/// and the reason as its ambiguity (the search reports it undecided).
+fn failed_solution(
+    matrix: DMatrix<f64>,
+    offsets: Vec<usize>,
+    column_scale: DVector<f64>,
+    error: &NumericError,
+) -> LinearSolution {
+    let cols = matrix.ncols();
+    LinearSolution {
+        consistent: false,
+        residual: f64::NAN,
+        particular: DVector::zeros(cols),
+        nullspace: DMatrix::zeros(cols, 0),
+        rank: 0,
+        matrix,
+        offsets,
+        column_scale,
+        ambiguity: Some(error.to_string()),
+    }
+}
+
+/// `‖A_S x + b‖/‖b‖` of the least-squares solution, by the same SVD and the same arithmetic as
+/// [`numeric_solve`]'s residual — what the exact path reports for an inconsistent variant,
+/// whose verdict it already has. Only that one factorisation is computed: the second
+/// (nalgebra's basis of the family) would be thrown away.
+pub fn least_squares_residual(
+    basis: &LiftedBasis,
+    elements: &[usize],
+) -> Result<f64, NumericError> {
+    let (matrix, _) = basis.system(elements);
+    let b = &basis.unbalanced;
+    ensure_finite(b.iter(), "b")?;
+    let column_scale = column_norms(&matrix);
+    let triplets = faer_triplets(&matrix, &column_scale)
+        .or_else(|_| nalgebra_triplets(&matrix, &column_scale))?;
+    let residual = family_from_svd(&matrix, b, &column_scale, &triplets).residual;
+    ensure_finite(std::iter::once(&residual), "residual")?;
+    Ok(residual)
 }
 
 /// Solves one variant's balance system in floating point. faer's SVD decides — rank,
 /// consistency and the ambiguous zone of the module documentation. The family handed on is
 /// nalgebra's SVD basis of the span when that one agrees (same rank, and it solves the system
 /// when faer says it is solvable): the optimiser's local searches were tuned on that basis;
-/// otherwise faer's.
+/// otherwise faer's. A non-finite coefficient or an SVD that fails both ways gives an
+/// inconsistent solution whose `ambiguity` says why (the variant is undecided), never a panic.
 pub fn numeric_solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
     let (matrix, offsets) = basis.system(elements);
     let b = &basis.unbalanced;
     let column_scale = column_norms(&matrix);
+    if let Err(e) = ensure_finite(matrix.iter().chain(b.iter()), "A_S or b") {
+        return failed_solution(matrix, offsets, column_scale, &e);
+    }
     let triplets = match faer_triplets(&matrix, &column_scale) {
         Ok(t) => t,
         Err(reason) => {
-            let family = family_from_svd(
-                &matrix,
-                b,
-                &column_scale,
-                &nalgebra_triplets(&matrix, &column_scale),
-            );
+            let family = match nalgebra_triplets(&matrix, &column_scale) {
+                Ok(t) => family_from_svd(&matrix, b, &column_scale, &t),
+                Err(_) => return failed_solution(matrix, offsets, column_scale, &reason),
+            };
             return LinearSolution {
                 consistent: false,
                 matrix,
@@ -349,7 +548,7 @@ pub fn numeric_solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution 
                 nullspace: family.nullspace,
                 rank: family.rank,
                 column_scale,
-                ambiguity: Some(reason),
+                ambiguity: Some(reason.to_string()),
             };
         }
     };
@@ -374,14 +573,16 @@ pub fn numeric_solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution 
              nor clearly not (> {INCONSISTENCY_TOL:.0e})"
         ));
     }
-    let tuned = family_from_svd(
-        &matrix,
-        b,
-        &column_scale,
-        &nalgebra_triplets(&matrix, &column_scale),
-    );
-    let agrees = tuned.rank == decided.rank && (!consistent || tuned.residual <= CONSISTENCY_TOL);
-    let family = if agrees { tuned } else { decided };
+    // nalgebra's basis only when it exists and agrees; faer's decision stands either way.
+    let family = match nalgebra_triplets(&matrix, &column_scale) {
+        Ok(t) => {
+            let tuned = family_from_svd(&matrix, b, &column_scale, &t);
+            let agrees =
+                tuned.rank == decided.rank && (!consistent || tuned.residual <= CONSISTENCY_TOL);
+            if agrees { tuned } else { decided }
+        }
+        Err(_) => decided,
+    };
     LinearSolution {
         consistent,
         matrix,
@@ -396,6 +597,15 @@ pub fn numeric_solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution 
 }
 
 impl LinearSolution {
+    /// `Err` when the particular solution or a free direction has a NaN or infinite entry
+    /// (an exact family whose numbers overflow a double).
+    pub fn ensure_finite(&self) -> Result<(), NumericError> {
+        ensure_finite(
+            self.particular.iter().chain(self.nullspace.iter()),
+            "solution set",
+        )
+    }
+
     /// Whether lifted variable `j` takes the same value in every solution.
     pub fn is_fixed(&self, j: usize) -> bool {
         // Nullspace columns come from orthonormal scaled vectors: compare in scaled units.
@@ -423,5 +633,78 @@ impl LinearSolution {
         let moving = a_k * self.nullspace.rows(range.start, range.len());
         // `A_k N` is in scaled units (unit columns times orthonormal vectors): at most 1.
         moving.iter().all(|v| v.abs() <= FIXED_TOL)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A basis with one element of two columns over three monomials, `b` as given.
+    fn basis(a: [[f64; 2]; 3], b: [f64; 3]) -> LiftedBasis {
+        LiftedBasis {
+            monomials: (0..3).map(Monomial::sine).collect(),
+            unbalanced: DVector::from_row_slice(&b),
+            elements: vec![DMatrix::from_fn(3, 2, |i, j| a[i][j])],
+            exact: None,
+        }
+    }
+
+    /// NaN or infinity in `A_S` or `b` is an error with the reason, from every entry point:
+    /// no SVD is attempted on it, so none can panic or loop.
+    #[test]
+    fn non_finite_coefficients_are_an_error_not_a_panic() {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for (a, b) in [
+                ([[1.0, 0.0], [0.0, bad], [0.0, 0.0]], [1.0, 0.0, 0.0]),
+                ([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]], [1.0, bad, 0.0]),
+            ] {
+                let basis = basis(a, b);
+                let solution = numeric_solve(&basis, &[0]);
+                assert!(!solution.consistent);
+                let reason = solution.ambiguity.expect("a reason");
+                assert!(reason.contains("not finite"), "{reason}");
+                assert!(least_squares_residual(&basis, &[0]).is_err());
+                let (matrix, _) = basis.system(&[0]);
+                let scale = column_norms(&matrix);
+                if matrix.iter().any(|v| !v.is_finite()) {
+                    assert!(faer_triplets(&matrix, &scale).is_err());
+                    assert!(nalgebra_triplets(&matrix, &scale).is_err());
+                }
+            }
+        }
+    }
+
+    /// A finite system still solves, and both SVDs agree on it: `x = (1, 2)` solves
+    /// `[[1, 0], [0, 1], [0, 0]] x = −(−1, −2, 0)` exactly, by hand.
+    #[test]
+    fn a_finite_system_solves_by_either_svd() {
+        let basis = basis([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]], [-1.0, -2.0, 0.0]);
+        let solution = numeric_solve(&basis, &[0]);
+        assert!(solution.ambiguity.is_none());
+        assert!(solution.consistent);
+        assert_eq!(solution.rank, 2);
+        assert!((solution.particular[0] - 1.0).abs() < 1e-12);
+        assert!((solution.particular[1] - 2.0).abs() < 1e-12);
+        assert!(least_squares_residual(&basis, &[0]).unwrap() < 1e-15);
+    }
+
+    /// The fallback of nalgebra's SVD, without the zero rows and columns, gives the triplets
+    /// of the whole matrix: by hand, `[[0, 3, 0], [0, 0, 0], [0, 0, 4]]` has σ = 4, 3, 0 with
+    /// right vectors e₃, e₂, e₁.
+    #[test]
+    fn zero_rows_and_columns_are_an_exact_reduction() {
+        let matrix = DMatrix::from_row_slice(3, 3, &[0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 4.0]);
+        let scale = DVector::from_element(3, 1.0);
+        let full = nalgebra_triplets(&matrix, &scale).unwrap();
+        let mut sigma: Vec<f64> = full.iter().map(|t| t.0).collect();
+        sigma.sort_by(|a, b| b.total_cmp(a));
+        assert_eq!(sigma, vec![4.0, 3.0, 0.0]);
+        // Reduced by hand to [[3, 0], [0, 4]]: the same values, the zero column's e₁ added.
+        let reduced = nalgebra_svd(DMatrix::from_row_slice(2, 2, &[3.0, 0.0, 0.0, 4.0]), 2);
+        let reduced: Vec<f64> = reduced.unwrap().iter().map(|t| t.0).collect();
+        assert_eq!(reduced, vec![4.0, 3.0]);
+        let e1 = full.iter().find(|t| t.0 == 0.0).unwrap();
+        assert!((e1.2[0].abs() - 1.0).abs() < 1e-15);
     }
 }

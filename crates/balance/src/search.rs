@@ -270,7 +270,10 @@ fn decide_exact(
     let solution = exact.solve(&set);
     result.rank = solution.rank();
     if !solution.consistent() {
-        result.linear_residual = crate::linear::numeric_solve(numeric, &set).residual;
+        // Only informative (the verdict is exact): the least-squares residual of one SVD, or
+        // NaN (`null` in JSON) when no SVD of the system converges.
+        result.linear_residual =
+            crate::linear::least_squares_residual(numeric, &set).unwrap_or(f64::NAN);
         result.reason = Some(format!(
             "the balance equations have no solution (exact: rank {} of the element columns, \
              {} with the unbalanced energy)",
@@ -294,6 +297,15 @@ fn decide_exact(
     let (names, units) = names_and_units(entries);
     result.relations = exact_relations(&solution, &names, &units);
     let linear = crate::linear::from_exact(numeric, &solution);
+    if let Err(e) = linear.ensure_finite() {
+        // The exact family exists, but rounded to doubles it overflows: no witness search or
+        // optimisation can work on it.
+        result.status = Status::Undecided;
+        result.reason = Some(format!(
+            "the exact solution set cannot be used in floating point: {e}"
+        ));
+        return;
+    }
     let positive: Vec<usize> = (0..entries.len()).map(|k| solution.offsets[k]).collect();
     result.free_directions = free_directions(&linear, &names, &positive);
 
