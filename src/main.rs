@@ -48,6 +48,10 @@ enum Command {
         /// Print the full results as JSON instead of tables.
         #[arg(long)]
         json: bool,
+        /// Only the minimal balancing sets (no proper subset balances), each decided in full,
+        /// and the smallest Dmax at which a variant balances: a pruned walk, for high Dmax.
+        #[arg(long)]
+        minimal: bool,
         #[command(flatten)]
         jobs: Jobs,
     },
@@ -232,8 +236,12 @@ fn run(cli: Cli) -> ExitCode {
     let result = match cli.command {
         Command::Check { case, .. } => commands::check::run(&case),
         Command::Variants {
-            case, dmax, json, ..
-        } => commands::variants::run(&case, dmax, json),
+            case,
+            dmax,
+            json,
+            minimal,
+            ..
+        } => commands::variants::run(&case, dmax, json, minimal),
         Command::Evaluate {
             case,
             states: Some(states),

@@ -5,17 +5,19 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
+use counterpoise_balance::minimal::{MinimalReport, estimate_tested, minimal_search};
 use counterpoise_balance::{
     Attachment, Catalogue, Class, Decision, SearchOptions, SearchReport, Status, VariantResult,
     catalogue_options, mechanism_energy, realization_hints, search,
 };
-use counterpoise_model::{Model, Plane};
+use counterpoise_model::limits::{Limit, format_count};
+use counterpoise_model::{Model, ModelError, Plane};
 use serde_json::json;
 
 /// Version of the `variants --json` schema (documented in README.md).
 pub const SCHEMA_VERSION: u32 = 1;
 
-pub fn run(path: &Path, dmax: Option<usize>, as_json: bool) -> Result<ExitCode> {
+pub fn run(path: &Path, dmax: Option<usize>, as_json: bool, minimal: bool) -> Result<ExitCode> {
     let Some(model) = super::load(path)? else {
         return Ok(ExitCode::FAILURE);
     };
@@ -30,6 +32,9 @@ pub fn run(path: &Path, dmax: Option<usize>, as_json: bool) -> Result<ExitCode> 
     let dmax = dmax.unwrap_or(balancing.dmax);
     if dmax == 0 {
         bail!("--dmax must be at least 1");
+    }
+    if minimal {
+        return run_minimal(path, &model, dmax, source, as_json);
     }
     if let Err(e) = counterpoise::preflight::variant_guard(&model, dmax, source) {
         super::print_errors(path, &super::located(path, vec![e]));
@@ -276,6 +281,255 @@ pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -
                 v.status.name(),
                 v.reason.as_deref().unwrap_or("")
             ));
+        }
+    }
+    out
+}
+
+/// Linear tests of the minimal-set walk counted as one variant by the variant guard: a test is
+/// one element's columns reduced modulo a prime (about 10 µs on the 6-axis arm), a variant's
+/// full decision takes about 10 ms; 100 keeps the walk well under the time a refused variant
+/// count would take.
+pub const WALK_TESTS_PER_VARIANT: u64 = 100;
+
+/// The variant guard of `--minimal`: the pruned walk's size (the reach pruning alone, an upper
+/// estimate of the sets it tests) against the variants limit, instead of `C(n, ≤ Dmax)`.
+fn minimal_guard(
+    exact: &counterpoise_balance::exact::ExactBasis,
+    dmax: usize,
+    source: &str,
+) -> Result<u64, ModelError> {
+    let limits = counterpoise::preflight::limits();
+    let refuse = |what: String, found: f64, limit: Limit| ModelError::Invalid {
+        path: source.to_string(),
+        reason: format!(
+            "{} {what}; the limit is {}; lower --dmax or restrict the elements, or {}",
+            format_count(found),
+            format_count(limits.get(limit) as f64),
+            limit.hint()
+        ),
+    };
+    if dmax as u64 > limits.dmax {
+        return Err(refuse(
+            "elements per variant".into(),
+            dmax as f64,
+            Limit::Dmax,
+        ));
+    }
+    let budget = limits.variants.saturating_mul(WALK_TESTS_PER_VARIANT);
+    let estimate = estimate_tested(exact, dmax, budget);
+    if estimate > budget {
+        // The count stops once past the budget: say so rather than quote the partial count.
+        return Err(ModelError::Invalid {
+            path: source.to_string(),
+            reason: format!(
+                "more than {} sets for the minimal-set walk to test at Dmax {dmax}, counted \
+                 after pruning ({WALK_TESTS_PER_VARIANT} tests count as one variant); the \
+                 limit is {} variants; lower --dmax or restrict the elements, or {}",
+                format_count(budget as f64),
+                format_count(limits.variants as f64),
+                Limit::Variants.hint()
+            ),
+        });
+    }
+    Ok(estimate)
+}
+
+/// `variants --minimal`: the minimal balancing sets up to Dmax, each decided in full.
+fn run_minimal(
+    path: &Path,
+    model: &Model,
+    dmax: usize,
+    source: &str,
+    as_json: bool,
+) -> Result<ExitCode> {
+    let started = Instant::now();
+    let energy = mechanism_energy(model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
+    if catalogue.is_empty() {
+        bail!(
+            "{}: `balancing` allows no counterweight and no spring",
+            path.display()
+        );
+    }
+    let exact = match &energy.exact {
+        Ok(mechanism) => counterpoise_balance::exact::ExactBasis::build(mechanism, &catalogue),
+        Err(reason) => bail!(
+            "{}: minimal sets need an exact case (every number rational); this one is decided \
+             in floating point: {reason}",
+            path.display()
+        ),
+    };
+    if let Err(e) = minimal_guard(&exact, dmax, source) {
+        super::print_errors(path, &super::located(path, vec![e]));
+        return Ok(ExitCode::FAILURE);
+    }
+    let report = minimal_search(
+        &energy,
+        catalogue,
+        SearchOptions {
+            dmax,
+            hints: realization_hints(model),
+        },
+    )?;
+    let elapsed = started.elapsed().as_secs_f64();
+    if as_json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&minimal_json(model, dmax, &report, elapsed))?
+        );
+    } else {
+        print!("{}", minimal_tables(model, dmax, &report, elapsed));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The `variants --minimal --json` document.
+pub fn minimal_json(
+    model: &Model,
+    dmax: usize,
+    report: &MinimalReport,
+    seconds: f64,
+) -> serde_json::Value {
+    let catalogue: Vec<_> = report
+        .catalogue
+        .entries
+        .iter()
+        .map(
+            |e| json!({ "label": e.label, "description": e.description, "variables": e.variables }),
+        )
+        .collect();
+    let mut counts = serde_json::Map::new();
+    for status in Status::ALL {
+        let n = report.sets.iter().filter(|v| v.status == status).count();
+        counts.insert(status.name().into(), json!(n));
+    }
+    json!({
+        "schema_version": SCHEMA_VERSION,
+        "case": model.name,
+        "dmax": dmax,
+        "seconds": seconds,
+        "catalogue": catalogue,
+        "minimal": {
+            "smallest_linear": report.smallest_linear,
+            "smallest_balanced": report.smallest_balanced,
+            "smallest_balanced_note": report.smallest_balanced_note,
+            "tested": report.tested,
+            "estimate": report.estimate,
+            "combinations": report.combinations.to_string(),
+            "supersets_decided": report.supersets_decided,
+            "first_balanced": report.first_balanced,
+            "disagreements": report.disagreements,
+            "counts": counts,
+        },
+        "variants": report.sets,
+    })
+}
+
+/// The human-readable report of `--minimal`.
+pub fn minimal_tables(model: &Model, dmax: usize, report: &MinimalReport, seconds: f64) -> String {
+    let mut out = String::new();
+    let (cw, springs) = report.catalogue.counts();
+    out.push_str(&format!(
+        "{}: {} elements ({cw} counterweights, {springs} springs), minimal balancing sets up to \
+         Dmax {dmax}: {} in {:.3} s\n",
+        model.name,
+        report.catalogue.len(),
+        report.sets.len(),
+        seconds
+    ));
+    out.push_str(&format!(
+        "pruned walk: {} sets tested (estimate {}) instead of all {} combinations; every set \
+         confirmed in exact arithmetic\n",
+        report.tested, report.estimate, report.combinations
+    ));
+    if report.disagreements > 0 {
+        out.push_str(&format!(
+            "warning: the modular screen and the exact confirmation disagreed on {} sets\n",
+            report.disagreements
+        ));
+    }
+    match report.smallest_linear {
+        None => out.push_str(&format!(
+            "no set of at most {dmax} elements balances this mechanism, even at the linear level\n"
+        )),
+        Some(d) => out.push_str(&format!(
+            "smallest Dmax with solvable balance equations: {d}\n"
+        )),
+    }
+    match (report.smallest_balanced, &report.smallest_balanced_note) {
+        (Some(d), None) => out.push_str(&format!(
+            "smallest Dmax at which a variant balances (verified witness): {d}\n"
+        )),
+        (Some(d), Some(note)) => out.push_str(&format!(
+            "smallest Dmax at which a variant balances: at most {d} ({note})\n"
+        )),
+        (None, note) => out.push_str(&format!(
+            "no variant of at most {dmax} elements balances with verified physical parameters{}\n",
+            note.as_ref().map_or(String::new(), |n| format!(" ({n})"))
+        )),
+    }
+    if report.supersets_decided > 0 {
+        out.push_str(&format!(
+            "({} non-minimal balancing sets decided in full to find it)\n",
+            report.supersets_decided
+        ));
+    }
+    if !report.first_balanced.is_empty() {
+        out.push_str(&format!(
+            "balanced at that size, each a minimal set plus what makes it realizable ({}):\n",
+            report.first_balanced.len()
+        ));
+        for v in &report.first_balanced {
+            let labels: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
+            out.push_str(&format!("  {}  {}\n", labels.join(" + "), v.class.name()));
+        }
+    }
+    out.push('\n');
+    out.push_str(&format!("{:<6}", "size"));
+    for status in Status::ALL {
+        out.push_str(&format!("{:>14}", status.name()));
+    }
+    out.push_str(&format!("{:>10}\n", "total"));
+    let largest = report
+        .sets
+        .iter()
+        .map(|v| v.elements.len())
+        .max()
+        .unwrap_or(0);
+    for d in 1..=largest {
+        let of_size: Vec<&VariantResult> = report
+            .sets
+            .iter()
+            .filter(|v| v.elements.len() == d)
+            .collect();
+        if of_size.is_empty() {
+            continue;
+        }
+        out.push_str(&format!("{d:<6}"));
+        for status in Status::ALL {
+            let n = of_size.iter().filter(|v| v.status == status).count();
+            out.push_str(&format!("{n:>14}"));
+        }
+        out.push_str(&format!("{:>10}\n", of_size.len()));
+    }
+    out.push('\n');
+    for v in &report.sets {
+        let labels: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
+        out.push_str(&format!(
+            "{}  {}  {}",
+            labels.join(" + "),
+            v.class.name(),
+            v.status.name()
+        ));
+        match v.status {
+            Status::Balanced => out.push_str(&format!("  free parameters: {}\n", v.nullity)),
+            _ => out.push_str(&format!(": {}\n", v.reason.as_deref().unwrap_or(""))),
+        }
+        if v.status == Status::Balanced {
+            for line in witness_lines(model, v) {
+                out.push_str(&format!("    {line}\n"));
+            }
         }
     }
     out

@@ -13,13 +13,16 @@
 //!    there are none;
 //! 5. [`verify`]: the witness's total energy sampled at random configurations;
 //! 6. [`relations`]: the balance relations and free directions in readable form;
-//! 7. [`search`]: all of it, in parallel, in a deterministic order.
+//! 7. [`search`]: all of it, in parallel, in a deterministic order;
+//! 8. [`minimal`]: the minimal balancing sets up to a high Dmax, by a pruned walk instead of
+//!    every combination.
 
 pub mod element;
 pub mod energy;
 pub mod enumerate;
 pub mod exact;
 pub mod linear;
+pub mod minimal;
 pub mod model_input;
 pub mod realize;
 pub mod relations;
