@@ -26,16 +26,18 @@ pub enum KinematicsError {
     },
     #[error("{what} is not finite at q = {q:?} (a number of the case overflows)")]
     NonFinite { what: &'static str, q: Vec<f64> },
-    #[error(
-        "the SVD of the actuator Jacobian did not converge in {iterations} iterations at q = {q:?}"
-    )]
-    SvdNotConverged { q: Vec<f64>, iterations: usize },
+    #[error("the SVD of the actuator Jacobian failed at q = {q:?}: {reason}")]
+    SvdFailed { q: Vec<f64>, reason: &'static str },
 }
 
 /// Most iterations of the SVD that checks the actuator Jacobian's condition number: it
 /// converges in a handful for the few coordinates a case has, so hitting the cap means the
 /// matrix is not a sane one (nalgebra's own default is no cap, which never returns on a NaN).
 const SVD_MAX_ITERATIONS: usize = 1000;
+
+/// nalgebra's default SVD tolerance (the one `SVD::new` uses): the same singular values as
+/// before the cap, bit for bit.
+const SVD_EPS: f64 = 5.0 * f64::EPSILON;
 
 /// Settings of the Newton solver.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,13 +75,21 @@ pub(crate) fn checked_lu(
             q: q.iter().copied().collect(),
         });
     }
-    let Some(svd) = SVD::try_new(g.clone(), false, false, f64::EPSILON, SVD_MAX_ITERATIONS) else {
-        return Err(KinematicsError::SvdNotConverged {
-            q: q.iter().copied().collect(),
-            iterations: SVD_MAX_ITERATIONS,
-        });
+    // Unordered: nalgebra's sorting panics on a NaN singular value, which its shifted QR can
+    // produce even from a finite, rank-deficient matrix (an underflowing Wilkinson shift). Only
+    // the largest and the smallest are needed.
+    let failed = |reason| KinematicsError::SvdFailed {
+        q: q.iter().copied().collect(),
+        reason,
+    };
+    let Some(svd) = SVD::try_new_unordered(g.clone(), false, false, SVD_EPS, SVD_MAX_ITERATIONS)
+    else {
+        return Err(failed("no convergence within the iteration cap"));
     };
     let singular = svd.singular_values;
+    if !singular.iter().all(|s| s.is_finite()) {
+        return Err(failed("a singular value is not finite"));
+    }
     let (max, min) = singular
         .iter()
         .fold((0.0f64, f64::INFINITY), |(hi, lo), &s| {
