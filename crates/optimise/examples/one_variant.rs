@@ -2,6 +2,8 @@
 //! prints each record (status, reason, passes, parameters, indicators) as JSON: a tool to look
 //! at one variant's optimisation without running the whole study.
 //!
+//! `MAX_NODES` in the environment sets the branch-and-bound's box limit.
+//!
 //! ```text
 //! cargo run --release -p counterpoise-optimise --example one_variant -- CASE DMAX m4+K42 [K32+K42 …]
 //! ```
@@ -44,7 +46,11 @@ fn main() {
         })
         .collect();
     let ctx = Context::new(&model, None).expect("context");
-    for out in optimise_all(&ctx, &chosen, &OptimiseOptions::default()) {
+    let mut options = OptimiseOptions::default();
+    if let Some(n) = std::env::var("MAX_NODES").ok().and_then(|v| v.parse().ok()) {
+        options.max_nodes = n;
+    }
+    for out in optimise_all(&ctx, &chosen, &options) {
         println!(
             "{}",
             serde_json::to_string_pretty(&out).expect("records serialise")

@@ -23,7 +23,7 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::certify::{BranchOptions, Design, Verdict, branch_and_bound};
+use crate::certify::{BranchOptions, Design, SearchState, Verdict, branch_and_bound};
 use crate::context::Context;
 use crate::problem::{CwPhysical, Objective, VariantProblem};
 use crate::progress::{ProgressSink, StageCounter};
@@ -97,6 +97,8 @@ struct Run {
     iterations: Vec<Iteration>,
     state: State,
     candidate: Option<Candidate>,
+    /// What the last branch-and-bound left (its next pass starts from these boxes).
+    search: Option<SearchState>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -240,18 +242,21 @@ fn critical_task_loop(
 
         let counter =
             StageCounter::start(progress, "critical-task pass", timings.passes, active.len());
-        let outcomes: Vec<(usize, Result<Candidate, Failure>)> = active
+        type Outcome = (usize, Result<Candidate, Failure>, Option<SearchState>);
+        let outcomes: Vec<Outcome> = active
             .par_iter()
             .map(|&k| {
-                let outcome = step(ctx, &runs[k], &failed, options);
+                let mut search = runs[k].search.clone();
+                let outcome = step(ctx, &runs[k], &failed, options, &mut search);
                 counter.tick();
-                (k, outcome)
+                (k, outcome, search)
             })
             .collect();
         timings.solve += started.elapsed();
         let started = Stopwatch::start();
         let mut evaluated: Vec<usize> = Vec::new();
-        for (k, outcome) in outcomes {
+        for (k, outcome, search) in outcomes {
+            runs[k].search = search;
             match outcome {
                 Ok(c) => {
                     runs[k].candidate = Some(c);
@@ -364,6 +369,7 @@ fn new_run(ctx: &Context, v: &VariantResult, options: &OptimiseOptions) -> Run {
         iterations: Vec::new(),
         state,
         candidate: None,
+        search: None,
     }
 }
 
@@ -380,6 +386,7 @@ fn step(
     run: &Run,
     failed: &BTreeSet<usize>,
     options: &OptimiseOptions,
+    search: &mut Option<SearchState>,
 ) -> Result<Candidate, Failure> {
     let problem = run
         .problem
@@ -510,8 +517,17 @@ fn step(
         solver_iterations: options.solver_iterations,
     };
     let b = &ctx.basis.unbalanced;
-    let verdict = branch_and_bound(problem, b, &tasks, options.objective, &branch, incumbent)
-        .map_err(Failure::Undecided)?;
+    let (verdict, state) = branch_and_bound(
+        problem,
+        b,
+        &tasks,
+        options.objective,
+        &branch,
+        incumbent,
+        search.take(),
+    )
+    .map_err(Failure::Undecided)?;
+    *search = Some(state);
     match verdict {
         Verdict::Optimal {
             design,
@@ -674,7 +690,9 @@ fn impossibility_certificate(
         max_nodes: branch.max_nodes.min(CERTIFICATE_NODES),
         ..*branch
     };
-    match branch_and_bound(problem, b, &[], Objective::Minimax, &wording, None) {
+    match branch_and_bound(problem, b, &[], Objective::Minimax, &wording, None, None)
+        .map(|(verdict, _)| verdict)
+    {
         Ok(Verdict::Impossible { nodes: n }) => format!(
             "no parameters within the bounds balance this variant ({}); proved by splitting \
              the anchor and counterweight box into {n} boxes, none of which holds a solution",

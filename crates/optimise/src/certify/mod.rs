@@ -23,6 +23,8 @@
 //!
 //! The order of work is fixed (best bound first, ties by creation order) and every step is
 //! deterministic, so the verdict, the design and the bound do not depend on threads or batches.
+//! A variant's search in a later pass of the critical-task loop resumes from the boxes the
+//! last one left ([`SearchState`]).
 
 pub mod node;
 
@@ -95,6 +97,35 @@ struct Open {
     z: Option<DVector<f64>>,
     /// The relaxation's error per counterweight ([`crate::relaxation::Relaxed::cw_errors`]).
     cw_errors: Vec<f64>,
+    /// Whether the bound is from an earlier search on fewer tasks (still a lower bound, but
+    /// the box is solved again on these tasks before it is split).
+    stale: bool,
+}
+
+/// What one search leaves for the next on the same variant: the tightened root box and every
+/// box not proved empty, with its bound. The critical-task loop adds tasks
+/// between searches, and every task only adds torque terms and peak rows, so a box proved
+/// empty stays empty and an old bound stays a lower bound: the next search starts from these
+/// boxes instead of the root and re-solves each before splitting it.
+#[derive(Clone, Debug)]
+pub struct SearchState {
+    root: NodeBox,
+    leaves: Vec<(NodeBox, f64)>,
+}
+
+impl SearchState {
+    /// Boxes the next search starts from.
+    pub fn boxes(&self) -> usize {
+        self.leaves.len()
+    }
+
+    /// The smallest bound of the boxes left (+∞ when none is left).
+    pub fn smallest_bound(&self) -> f64 {
+        self.leaves
+            .iter()
+            .map(|l| l.1)
+            .fold(f64::INFINITY, f64::min)
+    }
 }
 
 /// Solves the relaxation on `node`; `None` when the box is proved to hold no point (the
@@ -120,6 +151,7 @@ fn bound_box(
             node,
             z: Some(relaxed.z),
             cw_errors: relaxed.cw_errors,
+            stale: false,
         }),
         // Not solved (nor proved infeasible): the box keeps its parent's bound and is split.
         _ => Some(Open {
@@ -128,6 +160,7 @@ fn bound_box(
             node,
             z: None,
             cw_errors: Vec::new(),
+            stale: false,
         }),
     }
 }
@@ -323,7 +356,9 @@ fn tighten(problem: &VariantProblem, mut root: NodeBox, options: &BranchOptions)
 }
 
 /// Branch-and-bound for the variant on `tasks`, starting from an optional design found
-/// otherwise (its value is the first upper bound).
+/// otherwise (its value is the first upper bound) and from the boxes an earlier search on a
+/// subset of `tasks` left (`warm`; from the root box when `None`). Returns the verdict and
+/// what this search leaves for the next.
 pub fn branch_and_bound(
     problem: &VariantProblem,
     b: &DVector<f64>,
@@ -331,8 +366,12 @@ pub fn branch_and_bound(
     objective: Objective,
     options: &BranchOptions,
     incumbent: Option<Design>,
-) -> Result<Verdict, String> {
-    let root = tighten(problem, NodeBox::root(problem)?, options);
+    warm: Option<SearchState>,
+) -> Result<(Verdict, SearchState), String> {
+    let (root, leaves) = match warm {
+        Some(w) => (w.root, Some(w.leaves)),
+        None => (tighten(problem, NodeBox::root(problem)?, options), None),
+    };
     let base = RelaxationBase::new(problem, tasks, objective);
     // Peak rows found active in any box so far: every later box starts with them.
     let mut active = Vec::new();
@@ -343,25 +382,43 @@ pub fn branch_and_bound(
         .fold(0.0f64, |a, &v| a.max(v.abs()))
         .max(1e-9);
     let mut best = incumbent;
-    let mut nodes = 1;
+    let mut nodes = 0;
     let mut open: Vec<Open> = Vec::new();
     let mut order = 0;
-    if let Some(o) = bound_box(
-        problem,
-        &base,
-        &mut active,
-        options,
-        root.clone(),
-        f64::NEG_INFINITY,
-        order,
-    ) {
-        open.push(o);
+    match leaves {
+        Some(leaves) => {
+            for (node, bound) in leaves {
+                order += 1;
+                open.push(Open {
+                    bound,
+                    order,
+                    node,
+                    z: None,
+                    cw_errors: Vec::new(),
+                    stale: true,
+                });
+            }
+        }
+        None => {
+            nodes += 1;
+            if let Some(o) = bound_box(
+                problem,
+                &base,
+                &mut active,
+                options,
+                root.clone(),
+                f64::NEG_INFINITY,
+                order,
+            ) {
+                open.push(o);
+            }
+        }
     }
     // Boxes too small to split that hold no design: their bounds stay in the global one.
-    let mut stuck: Vec<f64> = Vec::new();
-    // The smallest bound of the boxes closed because their bound came within the tolerance of
-    // the best design: part of the certified lower bound.
-    let mut pruned = f64::INFINITY;
+    let mut stuck: Vec<(NodeBox, f64)> = Vec::new();
+    // The boxes closed because their bound came within the tolerance of the best design (their
+    // bounds are part of the certified lower bound).
+    let mut pruned: Vec<(NodeBox, f64)> = Vec::new();
     let closes = |bound: f64, best: &Option<Design>| {
         best.as_ref().is_some_and(|d| {
             d.value - bound <= options.gap_tolerance * d.value.abs().max(f64::MIN_POSITIVE)
@@ -371,32 +428,50 @@ pub fn branch_and_bound(
         let lowest = open
             .iter()
             .map(|o| o.bound)
-            .chain(stuck.iter().copied())
-            .fold(pruned, f64::min);
+            .chain(stuck.iter().chain(&pruned).map(|b| b.1))
+            .fold(f64::INFINITY, f64::min);
+        let finish = |open: Vec<Open>, stuck: Vec<(NodeBox, f64)>, pruned: Vec<(NodeBox, f64)>| {
+            let mut leaves: Vec<(NodeBox, f64)> =
+                open.into_iter().map(|o| (o.node, o.bound)).collect();
+            leaves.extend(stuck);
+            leaves.extend(pruned);
+            SearchState {
+                root: root.clone(),
+                leaves,
+            }
+        };
         if open.is_empty() || closes(lowest, &best) {
-            return Ok(match best {
-                Some(design) if stuck.is_empty() || closes(lowest, &Some(design.clone())) => {
-                    let lower_bound = lowest.min(design.value);
-                    Verdict::Optimal {
-                        design,
-                        lower_bound,
-                        nodes,
+            let state = finish(open, stuck.clone(), pruned);
+            return Ok((
+                match best {
+                    Some(design) if stuck.is_empty() || closes(lowest, &Some(design.clone())) => {
+                        let lower_bound = lowest.min(design.value);
+                        Verdict::Optimal {
+                            design,
+                            lower_bound,
+                            nodes,
+                        }
                     }
-                }
-                None if stuck.is_empty() => Verdict::Impossible { nodes },
-                design => Verdict::Stopped {
-                    design,
+                    None if stuck.is_empty() => Verdict::Impossible { nodes },
+                    design => Verdict::Stopped {
+                        design,
+                        lower_bound: lowest,
+                        nodes,
+                    },
+                },
+                state,
+            ));
+        }
+        if nodes >= options.max_nodes {
+            let state = finish(open, stuck, pruned);
+            return Ok((
+                Verdict::Stopped {
+                    design: best,
                     lower_bound: lowest,
                     nodes,
                 },
-            });
-        }
-        if nodes >= options.max_nodes {
-            return Ok(Verdict::Stopped {
-                design: best,
-                lower_bound: lowest,
-                nodes,
-            });
+                state,
+            ));
         }
         // Best bound first; among bounds within half the gap tolerance of the lowest (a tie:
         // for a springs-only variant every box has the same bound), the newest box, so that
@@ -411,6 +486,25 @@ pub fn branch_and_bound(
                     .expect("open is not empty")
             });
         let current = open.swap_remove(at);
+        if current.stale {
+            nodes += 1;
+            if let Some(o) = bound_box(
+                problem,
+                &base,
+                &mut active,
+                options,
+                current.node,
+                current.bound,
+                current.order,
+            ) {
+                if closes(o.bound, &best) {
+                    pruned.push((o.node, o.bound));
+                } else {
+                    open.push(o);
+                }
+            }
+            continue;
+        }
         // A design is sought where it could improve on the best one: where the relaxed point's
         // true objective is below it (the refinement only moves to feasibility nearby).
         let promising = |z: &DVector<f64>| {
@@ -430,7 +524,7 @@ pub fn branch_and_bound(
             best = Some(d);
         }
         if closes(current.bound, &best) {
-            pruned = pruned.min(current.bound);
+            pruned.push((current.node, current.bound));
             continue;
         }
         let counterweights_first = current.z.as_ref().is_some_and(|z| {
@@ -439,7 +533,7 @@ pub fn branch_and_bound(
         });
         let Some(k) = branching_coordinate(problem, &coords, &root, &current, counterweights_first)
         else {
-            stuck.push(current.bound);
+            stuck.push((current.node, current.bound));
             continue;
         };
         for child in current.node.split(k) {
@@ -457,7 +551,7 @@ pub fn branch_and_bound(
                 continue;
             };
             if closes(o.bound, &best) {
-                pruned = pruned.min(o.bound);
+                pruned.push((o.node, o.bound));
             } else {
                 open.push(o);
             }

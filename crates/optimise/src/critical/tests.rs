@@ -6,10 +6,12 @@
 
 use super::*;
 use crate::springs::realize_springs;
+use crate::torque::TaskTorques;
 use counterpoise_balance::{Catalogue, SearchOptions, catalogue_options, mechanism_energy};
 use counterpoise_balance::{realization_hints, search};
 use counterpoise_dynamics::evaluate_grid;
 use counterpoise_model::{Case, Model};
+use std::sync::Arc;
 
 fn case_json(name: &str) -> serde_json::Value {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -351,4 +353,79 @@ fn an_interval_is_unbounded_along_what_no_bound_constrains() {
     // of 1000 N/m and what those need.
     assert!((k + hi - 10000.0).abs() <= 1e-6, "{}", k + hi);
     assert!(k + lo >= 1000.0 - 1e-6 && lo < 0.0, "{}", k + lo);
+}
+
+/// A search that starts from the boxes an earlier search left on fewer tasks (the critical-task
+/// loop's next pass) ends where a search from the root ends: the same verdict, each design
+/// within the gap tolerance of the other's certified bound. Its starting boxes' smallest bound
+/// is at most the optimum on the larger task set (a bound on fewer tasks is a lower bound on
+/// more), and the boxes it spent are fewer (the earlier search's splits are not redone).
+#[test]
+fn a_search_resumed_on_more_tasks_ends_where_a_fresh_one_does() {
+    // The pendulum with a counterweight m1 and a spring K10 to the base that can carry only
+    // 100 · 0.3 · 0.2 = 6 of the rod's 9.81 N·m: the search must split the anchors and the
+    // counterweight (the certified-stage tests' hybrid case).
+    let mut json = case_json("pendulum.json");
+    let b = &mut json["balancing"];
+    b["bounds"] = serde_json::json!({
+        "mass": [0.0, 5.0], "radius": [0.0, 1.0],
+        "stiffness": [1.0, 100.0], "anchor_a": [0.0, 0.3], "anchor_b": [0.0, 0.2]
+    });
+    b["counterweights"]["shape"] =
+        serde_json::json!({ "cylinder": { "radius_to_thickness": 0.5, "density": 7850.0 } });
+    b["dmax"] = serde_json::json!(2);
+    let model = model(&json);
+    let ctx = Context::new(&model, None).unwrap();
+    let variant = balanced_variant(&model, &["m1", "K10"]);
+    let options = OptimiseOptions::default();
+    let run = new_run(&ctx, &variant, &options);
+    let problem = run.problem.as_ref().unwrap();
+    let few: Vec<usize> = vec![0, 1];
+    let more: Vec<usize> = (0..ctx.tasks.len().min(6)).collect();
+    assert!(more.len() > few.len());
+    let (few_tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &few);
+    let (more_tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &more);
+    let branch = BranchOptions {
+        gap_tolerance: options.gap_tolerance,
+        max_nodes: 2000,
+        solver_iterations: options.solver_iterations,
+    };
+    let b = &ctx.basis.unbalanced;
+    let search = |tasks: &[Arc<TaskTorques>], warm: Option<SearchState>| {
+        branch_and_bound(problem, b, tasks, options.objective, &branch, None, warm).unwrap()
+    };
+    let (first, state) = search(&few_tasks, None);
+    assert!(matches!(first, Verdict::Optimal { .. }), "{first:?}");
+    let smallest = state.smallest_bound();
+    let (cold, _) = search(&more_tasks, None);
+    let (warm, _) = search(&more_tasks, Some(state));
+    let (
+        Verdict::Optimal {
+            design: cold_design,
+            lower_bound: cold_bound,
+            nodes: cold_nodes,
+        },
+        Verdict::Optimal {
+            design: warm_design,
+            lower_bound: warm_bound,
+            nodes: warm_nodes,
+        },
+    ) = (cold, warm)
+    else {
+        panic!("both searches must end optimal");
+    };
+    let tol = 1e-6;
+    assert!(warm_design.value >= cold_bound * (1.0 - tol));
+    assert!(cold_design.value >= warm_bound * (1.0 - tol));
+    assert!(
+        (warm_design.value - cold_design.value).abs() <= 1e-6 * cold_design.value,
+        "{} vs {}",
+        warm_design.value,
+        cold_design.value
+    );
+    assert!(smallest <= cold_design.value * (1.0 + 1e-9), "{smallest}");
+    assert!(
+        warm_nodes < cold_nodes,
+        "resumed {warm_nodes} boxes, fresh {cold_nodes}"
+    );
 }
