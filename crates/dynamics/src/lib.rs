@@ -17,6 +17,7 @@ pub mod fast;
 pub mod indicators;
 pub mod kernel;
 pub mod law;
+pub mod linalg;
 pub mod lu;
 pub mod mechanism;
 pub mod params;

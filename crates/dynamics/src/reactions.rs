@@ -26,8 +26,9 @@
 //! left null space of `A` (constraint wrenches do no work on admissible motions) — checked once
 //! at set-up; otherwise a full SVD per sample.
 
+use crate::linalg::checked_svd;
 use counterpoise_model::{BodyId, JointKind, Model};
-use nalgebra::{DMatrix, DVector, Dyn, SVD, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 
 use crate::kernel::required_wrenches_with;
 use crate::lu::SmallLu;
@@ -37,30 +38,6 @@ use crate::regressor::{SampleRegressor, SpringFrame};
 
 /// Relative singular-value threshold of the pseudo-inverse.
 pub const RANK_TOLERANCE: f64 = 1e-10;
-/// Most iterations of an SVD of the reaction matrix: it converges in tens for any sane one,
-/// and nalgebra's default (no cap) never returns on a matrix it cannot reduce.
-const SVD_MAX_ITERATIONS: usize = 10_000;
-
-/// The SVD of a reaction matrix, or `None`: capped at [`SVD_MAX_ITERATIONS`], only of finite
-/// entries (nalgebra's SVD never returns on a NaN), and unordered with its values checked
-/// finite before they are sorted (its shifted QR can turn a finite rank-deficient matrix into
-/// a NaN singular value, on which its sorting panics). The tolerance is nalgebra's default and
-/// the order is `svd()`'s, so wherever `svd()` succeeds the result is the same, bit for bit.
-fn reaction_svd(a: DMatrix<f64>, vectors: bool) -> Option<SVD<f64, Dyn, Dyn>> {
-    if !a.iter().all(|x| x.is_finite()) {
-        return None;
-    }
-    let mut svd =
-        SVD::try_new_unordered(a, vectors, vectors, 5.0 * f64::EPSILON, SVD_MAX_ITERATIONS)?;
-    let finite =
-        |m: &Option<DMatrix<f64>>| m.as_ref().is_none_or(|m| m.iter().all(|x| x.is_finite()));
-    if !(svd.singular_values.iter().all(|s| s.is_finite()) && finite(&svd.u) && finite(&svd.v_t)) {
-        return None;
-    }
-    svd.sort_by_singular_values();
-    Some(svd)
-}
-
 #[derive(Clone, Debug)]
 struct JointInfo {
     kind: JointKind,
@@ -242,7 +219,7 @@ impl ReactionSolver {
         // slow path: nalgebra's uncapped SVD never returns on a NaN.
         if a.ncols() > 0
             && a.nrows() > 0
-            && let Some(svd) = reaction_svd(a.clone(), false)
+            && let Some(svd) = checked_svd(a.clone(), false)
         {
             let smax = svd.singular_values.max();
             solver.rank = svd
@@ -532,7 +509,7 @@ impl ReactionSolver {
         let a = DMatrix::from_column_slice(rows, k, &work.a);
         // Without an SVD the reactions of the sample are NaN (the task is then left out as
         // non-finite), not a made-up number.
-        work.pinv = Some(match reaction_svd(a, true) {
+        work.pinv = Some(match checked_svd(a, true) {
             Some(svd) => {
                 let smax = svd.singular_values.max();
                 svd.pseudo_inverse(RANK_TOLERANCE * smax)

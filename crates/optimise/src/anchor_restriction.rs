@@ -10,6 +10,7 @@
 //! refinement wander along those directions (they change the counterweights' optimum through
 //! the shared relations) and end where no spring fits.
 
+use counterpoise_dynamics::linalg::checked_svd;
 use nalgebra::{DMatrix, DVector};
 
 use crate::problem::SpringSlot;
@@ -98,7 +99,7 @@ pub fn restrict(
     padded.rows_mut(0, rows.len()).copy_from(&m);
     let mut padded_rhs = DVector::<f64>::zeros(r);
     padded_rhs.rows_mut(0, rows.len()).copy_from(&rhs);
-    let svd = padded.svd(true, true);
+    let svd = checked_svd(padded, true)?;
     let sigma_max = svd.singular_values.max();
     if sigma_max <= 1e-12 * nullspace.norm().max(1.0) {
         // The rows do not involve the free directions: they hold (or fail) on the whole family.

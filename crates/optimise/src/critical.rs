@@ -12,6 +12,7 @@
 //! largest per-task total RMS (minimax). It never exceeds the all-task objective at the same
 //! point, so the relaxation's bound on the final working set bounds the true optimum.
 
+use counterpoise_dynamics::linalg::checked_svd;
 use std::collections::BTreeSet;
 
 use counterpoise_balance::linear::solve;
@@ -1031,10 +1032,9 @@ fn free_parameters(
             .collect::<Vec<_>>(),
     );
     let delta = x - &problem.solution.particular;
-    let values = basis
-        .svd(true, true)
-        .solve(&delta, 1e-12)
-        .unwrap_or_else(|_| DVector::zeros(directions.len()));
+    let values = checked_svd(basis, true)
+        .and_then(|svd| svd.solve(&delta, 1e-12).ok())
+        .unwrap_or_else(|| DVector::zeros(directions.len()));
     let cw_rows = problem.cw_rows();
     directions
         .into_iter()

@@ -8,6 +8,7 @@
 //! smaller simplex guard against premature collapse. The best *feasible* point seen is kept,
 //! so the result never trades feasibility for objective.
 
+use counterpoise_dynamics::linalg::checked_svd;
 use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
@@ -57,9 +58,9 @@ pub fn project_fixed(problem: &VariantProblem, z: &DVector<f64>) -> DVector<f64>
     let a = DMatrix::from_fn(fixed.len(), d, |i, k| problem.nullspace[(fixed[i].0, k)]);
     let x = problem.lifted(z);
     let r = DVector::from_iterator(fixed.len(), fixed.iter().map(|&(row, v)| v - x[row]));
-    match a.clone().svd(true, true).solve(&r, 1e-12) {
-        Ok(dz) => z + dz,
-        Err(_) => z.clone(),
+    match checked_svd(a, true).and_then(|svd| svd.solve(&r, 1e-12).ok()) {
+        Some(dz) => z + dz,
+        None => z.clone(),
     }
 }
 
@@ -76,8 +77,10 @@ fn free_subspace(problem: &VariantProblem) -> DMatrix<f64> {
             a[(i, k)] = problem.nullspace[(row, k)];
         }
     }
-    let svd = a.svd(false, true);
-    let v_t = svd.v_t.expect("V computed");
+    // Without an SVD (a non-finite row) no direction is known to keep the rows.
+    let Some((svd, v_t)) = checked_svd(a, true).and_then(|s| s.v_t.clone().map(|v| (s, v))) else {
+        return DMatrix::zeros(d, 0);
+    };
     let smax = svd.singular_values.iter().fold(0.0f64, |x, &y| x.max(y));
     let cols: Vec<DVector<f64>> = (0..svd.singular_values.len())
         .filter(|&k| svd.singular_values[k] <= 1e-12 * smax.max(f64::MIN_POSITIVE))
@@ -118,8 +121,10 @@ pub fn counterweight_directions(problem: &VariantProblem) -> DMatrix<f64> {
             .unwrap_or(1.0);
         nc[(i, k)] / scale
     });
-    let svd = scaled.svd(false, true);
-    let v_t = svd.v_t.expect("V computed");
+    let Some((svd, v_t)) = checked_svd(scaled, true).and_then(|s| s.v_t.clone().map(|v| (s, v)))
+    else {
+        return DMatrix::zeros(problem.dim(), 0);
+    };
     let smax = svd.singular_values.iter().fold(0.0f64, |a, &b| a.max(b));
     let mut cols = Vec::new();
     for (k, &s) in svd.singular_values.iter().enumerate() {
@@ -192,7 +197,7 @@ pub fn project_radius(
         if worst <= 1e-14 {
             return Some(z);
         }
-        let step = jac.svd(true, true).solve(&g, 1e-12).ok()?;
+        let step = checked_svd(jac, true)?.solve(&g, 1e-12).ok()?;
         z -= directions * step;
     }
     None
