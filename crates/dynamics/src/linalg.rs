@@ -44,4 +44,55 @@ mod tests {
         assert!((svd.singular_values[1] - 3.0).abs() <= 1e-14);
         assert_eq!(svd.singular_values, a.svd(true, true).singular_values);
     }
+
+    /// nalgebra's unordered SVD of `a`, and whether its singular values, `U` and `Vᵀ` are all
+    /// finite: the premise of the test below, checked so that it cannot pass vacuously.
+    fn raw_parts_finite(a: &DMatrix<f64>, vectors: bool) -> [bool; 3] {
+        let svd = SVD::try_new_unordered(
+            a.clone(),
+            vectors,
+            vectors,
+            5.0 * f64::EPSILON,
+            SVD_MAX_ITERATIONS,
+        )
+        .unwrap();
+        let finite =
+            |m: &Option<DMatrix<f64>>| m.as_ref().is_none_or(|m| m.iter().all(|x| x.is_finite()));
+        [
+            svd.singular_values.iter().all(|s| s.is_finite()),
+            finite(&svd.u),
+            finite(&svd.v_t),
+        ]
+    }
+
+    /// Finite matrices whose decomposition nalgebra computes with a non-finite part give
+    /// `None`: every entry is finite, and so are their exact singular values (by hand: the
+    /// 2 × 2 one has rank 1, σ = √2·√(2.25² + 1.5e308²) ≈ 2.12e308 < f64::MAX; the 3 × 3 one
+    /// has one non-zero column c, σ = ‖c‖ ≈ 1e308), but the shifted QR overflows on the way —
+    /// a NaN singular value in the first (where sorting would panic), a non-finite `Vᵀ` with
+    /// finite values and `U` in the second. Each part of the check is needed: either alone
+    /// would pass one of them.
+    #[test]
+    fn a_non_finite_part_of_a_finite_matrix_gives_none() {
+        let values_only =
+            DMatrix::<f64>::from_column_slice(2, 2, &[2.25, 2.25, -1.5e308, -1.5e308]);
+        assert!(values_only.iter().all(|&x| x.is_finite()));
+        assert_eq!(raw_parts_finite(&values_only, false), [false, true, true]);
+        assert!(checked_svd(values_only.clone(), false).is_none());
+        assert!(checked_svd(values_only, true).is_none());
+
+        let v_only = DMatrix::<f64>::from_column_slice(
+            3,
+            3,
+            &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 2e150, 2e150, -1e308],
+        );
+        assert!(v_only.iter().all(|&x| x.is_finite()));
+        assert_eq!(raw_parts_finite(&v_only, true), [true, true, false]);
+        assert!(checked_svd(v_only.clone(), true).is_none());
+        // Without vectors only the values are computed, and they are finite here: the
+        // largest is the column's norm, 1e308 to within rounding.
+        let svd = checked_svd(v_only, false).unwrap();
+        let norm = (2.0 * (2e150f64 / 1e308).powi(2) + 1.0).sqrt() * 1e308;
+        assert!((svd.singular_values[0] - norm).abs() <= 1e-12 * norm);
+    }
 }
