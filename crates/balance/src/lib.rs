@@ -15,7 +15,9 @@
 //! 6. [`relations`]: the balance relations and free directions in readable form;
 //! 7. [`search`]: all of it, in parallel, in a deterministic order;
 //! 8. [`minimal`]: the minimal balancing sets up to a high Dmax, by a pruned walk instead of
-//!    every combination.
+//!    every combination;
+//! 9. [`partial`]: when nothing small balances exactly, the sets and parameters within the
+//!    bounds that leave the least gravity torque on the joints that matter.
 
 pub mod element;
 pub mod energy;
@@ -24,6 +26,7 @@ pub mod exact;
 pub mod linear;
 pub mod minimal;
 pub mod model_input;
+pub mod partial;
 pub mod realize;
 pub mod relations;
 pub mod search;

@@ -1,0 +1,454 @@
+//! Partial balancing with counterweights (`counterpoise_balance::partial`) against values found
+//! without it: closed forms worked out by hand on the pendulum, the gravity torques of every
+//! design recomputed from the model's kinematics (Jacobians, not the energy polynomials the
+//! search differentiates), and dense normal equations over those independent torques.
+
+mod common;
+
+use common::model_of;
+use counterpoise_balance::partial::{
+    CounterweightLimits, PartialDesign, PartialOptions, PartialReport, TorqueBasis, Workspace,
+    counterweight_entries, partial_search,
+};
+use counterpoise_balance::{Catalogue, catalogue_options, mechanism_energy};
+use counterpoise_model::{Kinematics, Model};
+use nalgebra::{DMatrix, DVector, Vector3};
+
+const G: f64 = 9.81;
+
+fn case(name: &str) -> serde_json::Value {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../cases")
+        .join(name);
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// `n` equally spaced values from `from` to `to`.
+fn spaced(from: f64, to: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| from + (to - from) * i as f64 / (n - 1) as f64)
+        .collect()
+}
+
+/// Every combination of the per-coordinate values (first coordinate slowest).
+fn grid(axes: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let mut points = vec![Vec::new()];
+    for values in axes {
+        points = points
+            .iter()
+            .flat_map(|p: &Vec<f64>| {
+                values.iter().map(move |&v| {
+                    let mut p = p.clone();
+                    p.push(v);
+                    p
+                })
+            })
+            .collect();
+    }
+    points
+}
+
+/// The search on `model` at configurations `qs`, every counterweight bounded by `limits`.
+fn search(
+    model: &Model,
+    qs: &[Vec<f64>],
+    limits: CounterweightLimits,
+    budget: usize,
+    joints: Vec<usize>,
+) -> PartialReport {
+    search_with(model, qs, limits, PartialOptions::new(budget, joints))
+}
+
+/// [`search`] with every option given.
+fn search_with(
+    model: &Model,
+    qs: &[Vec<f64>],
+    limits: CounterweightLimits,
+    options: PartialOptions,
+) -> PartialReport {
+    let energy = mechanism_energy(model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
+    let workspace = Workspace::new(model, qs);
+    assert_eq!(workspace.len(), qs.len(), "every point regular");
+    let cws = counterweight_entries(&catalogue);
+    let basis = TorqueBasis::build(&energy, &catalogue, &workspace, &cws);
+    let bounds: Vec<_> = (0..catalogue.len())
+        .map(|e| cws.contains(&e).then_some(limits))
+        .collect();
+    partial_search(&catalogue, &basis, &bounds, &options).unwrap()
+}
+
+/// Static actuator forces at `q` from the model's kinematics: every body with its payloads that
+/// count in the balance, plus point masses `(body, m, r)`, each needing the world wrench
+/// `F = −m g`, `N_o = (R c) × F`; `Q_q = Σ J_vᵀ F + J_ωᵀ N_o`, `Q_u = G⁻ᵀ Q_q`.
+fn static_forces(model: &Model, q: &[f64], extra: &[(usize, f64, Vector3<f64>)]) -> DVector<f64> {
+    let kin = Kinematics::new(model);
+    let qv = DVector::from_column_slice(q);
+    let g = model.gravity;
+    let mut masses: Vec<(usize, f64, Vector3<f64>)> = Vec::new();
+    for (i, b) in model.bodies.iter().enumerate() {
+        masses.push((i, b.mass, b.com));
+    }
+    for p in model.payloads.iter().filter(|p| p.in_balance) {
+        masses.push((p.body, p.mass, p.com));
+    }
+    masses.extend_from_slice(extra);
+    let mut generalized = DVector::zeros(q.len());
+    for (body, m, c) in masses {
+        let pose = kin.body_pose(body, &qv);
+        let jac = kin.body_jacobian(body, &qv);
+        let force = -g * m;
+        let moment = (pose.rotation * c).cross(&force);
+        generalized += jac.linear.transpose() * force + jac.angular.transpose() * moment;
+    }
+    let jacobian = kin.actuator_jacobian(&qv);
+    jacobian.transpose().lu().solve(&generalized).unwrap()
+}
+
+/// Per actuator, the RMS over `qs` of the static forces with the design's counterweights.
+fn recomputed_rms(model: &Model, qs: &[Vec<f64>], design: &PartialDesign) -> Vec<f64> {
+    let extra: Vec<_> = design
+        .counterweights
+        .iter()
+        .map(|c| (c.body, c.mass, Vector3::from(c.offset)))
+        .collect();
+    let mut sum = vec![0.0; model.actuators.len()];
+    for q in qs {
+        let f = static_forces(model, q, &extra);
+        for (s, v) in sum.iter_mut().zip(f.iter()) {
+            *s += v * v;
+        }
+    }
+    sum.iter().map(|s| (s / qs.len() as f64).sqrt()).collect()
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
+}
+
+/// Pendulum of `cases/pendulum.json`: rod of 2 kg with its centre of mass at 0.5 m, gravity
+/// −9.81 y, so `τ = 9.81·cos θ`; a counterweight with moment `μ` adds `9.81(μx cos θ − μy sin θ)`.
+/// On a grid symmetric about 0, `Σ cos θ sin θ = 0`, so the mean square is
+/// `9.81²[(1 + μx)² mean cos² + μy² mean sin²]`: with `|μ| ≤ r_hi·m_hi < 1` the optimum is
+/// `μ = (−r_hi·m_hi, 0)` and the RMS `9.81(1 − r_hi·m_hi)·√(mean cos²)`.
+#[test]
+fn pendulum_with_the_radius_bound_active_matches_the_closed_form() {
+    let model = model_of(&case("pendulum.json"));
+    let thetas = spaced(-1.5, 1.5, 7);
+    let qs: Vec<Vec<f64>> = thetas.iter().map(|&t| vec![t]).collect();
+    let mean_cos2 = thetas.iter().map(|t| t.cos().powi(2)).sum::<f64>() / 7.0;
+    let report = search(
+        &model,
+        &qs,
+        CounterweightLimits {
+            mass: [0.0, 2.0],
+            radius: [0.0, 0.25],
+        },
+        1,
+        vec![0],
+    );
+    assert!(close(report.unbalanced_total, G * mean_cos2.sqrt(), 1e-12));
+    let best = &report.designs[0];
+    let cw = &best.counterweights[0];
+    // m·r = (−0.5, 0): m at its bound 2 kg, r = (−0.25, 0) m.
+    assert!(close(cw.mass, 2.0, 1e-6), "{}", cw.mass);
+    assert!(close(cw.offset[0], -0.25, 1e-6), "{:?}", cw.offset);
+    assert!(cw.offset[1].abs() < 1e-6, "{:?}", cw.offset);
+    let expected = G * 0.5 * mean_cos2.sqrt();
+    assert!(
+        close(best.total_rms, expected, 1e-6),
+        "{} vs {expected}",
+        best.total_rms
+    );
+    assert!(best.lower_bound <= best.total_rms * (1.0 + 1e-6));
+    assert!(
+        close(best.lower_bound, expected, 1e-5),
+        "{}",
+        best.lower_bound
+    );
+    // The torque recomputed from the model's kinematics with that counterweight.
+    let rms = recomputed_rms(&model, &qs, best);
+    assert!(
+        close(rms[0], best.rms[0], 1e-9),
+        "{rms:?} vs {:?}",
+        best.rms
+    );
+}
+
+/// With room for `m·r = (−1, 0)` the pendulum balances: zero residual.
+#[test]
+fn pendulum_balances_when_the_bounds_allow_it() {
+    let model = model_of(&case("pendulum.json"));
+    let qs: Vec<Vec<f64>> = spaced(-1.5, 1.5, 7).into_iter().map(|t| vec![t]).collect();
+    let report = search(
+        &model,
+        &qs,
+        CounterweightLimits {
+            mass: [0.0, 4.0],
+            radius: [0.0, 1.0],
+        },
+        1,
+        vec![0],
+    );
+    let best = &report.designs[0];
+    assert!(
+        best.total_rms < 1e-6 * report.unbalanced_total,
+        "{}",
+        best.total_rms
+    );
+    let cw = &best.counterweights[0];
+    assert!(close(cw.mass * cw.offset[0], -1.0, 1e-6), "{cw:?}");
+    // The lightest of the balancing designs: m·|r| = 1 with |r| ≤ 1 m needs m ≥ 1 kg.
+    assert!(close(cw.mass, 1.0, 1e-4), "{cw:?}");
+    assert!(close(cw.offset[0], -1.0, 1e-4), "{cw:?}");
+}
+
+/// A counterweight the torque cannot see (on the 6-axis arm's shoulder, which turns about the
+/// vertical through its own origin) is left out: `m1 + m2` is `m2` with `m1` unused, at the
+/// same residual.
+#[test]
+fn a_counterweight_that_does_nothing_is_left_out() {
+    let model = model_of(&case("arm6.json"));
+    let qs = grid(&[
+        vec![0.0],
+        spaced(-3.1, 3.1, 5),
+        spaced(-3.1, 3.1, 5),
+        vec![0.0],
+        vec![0.0],
+        vec![0.0],
+    ]);
+    let limits = CounterweightLimits {
+        mass: [0.0, 30.0],
+        radius: [0.0, 0.5],
+    };
+    let report = search(&model, &qs, limits, 2, vec![1, 2]);
+    let find = |labels: &[&str]| {
+        report
+            .designs
+            .iter()
+            .find(|d| d.labels == labels)
+            .unwrap()
+            .clone()
+    };
+    let alone = find(&["m2"]);
+    let pair = find(&["m1", "m2"]);
+    assert_eq!(pair.unused, ["m1"]);
+    assert_eq!(pair.counterweights[0].mass, 0.0);
+    assert!(close(pair.total_rms, alone.total_rms, 1e-6));
+    // ranked after the smaller set with the same residual
+    let rank = |labels: &[&str]| report.designs.iter().position(|d| d.labels == labels);
+    assert!(rank(&["m2"]) < rank(&["m1", "m2"]));
+}
+
+/// A radius lower bound (non-convex): mass fixed at 3 kg, `|r| ∈ [0.5, 1]`, so `|μ| ≥ 1.5`
+/// while balance needs `μ = (−1, 0)`. Over the annulus the mean square is
+/// `(1 + μx)² Σcos² + μy² Σsin²` (× 9.81²/7); at `|μ| = 1.5` along −x it is `0.25·Σcos²`
+/// (0.78 on this grid), and any point off the axis pays more `Σsin²` (3.87, against
+/// `Σcos²` = 3.13): the optimum is `μ = (−1.5, 0)`, RMS `9.81·0.5·√(mean cos²)`. The convex
+/// relaxation (balance, 0) is the lower bound.
+#[test]
+fn pendulum_radius_lower_bound_is_met_along_the_convex_direction() {
+    let model = model_of(&case("pendulum.json"));
+    let thetas = spaced(-1.5, 1.5, 7);
+    let qs: Vec<Vec<f64>> = thetas.iter().map(|&t| vec![t]).collect();
+    let mean_cos2 = thetas.iter().map(|t| t.cos().powi(2)).sum::<f64>() / 7.0;
+    let report = search(
+        &model,
+        &qs,
+        CounterweightLimits {
+            mass: [3.0, 3.0],
+            radius: [0.5, 1.0],
+        },
+        1,
+        vec![0],
+    );
+    let best = &report.designs[0];
+    let cw = &best.counterweights[0];
+    assert!(close(cw.mass, 3.0, 1e-6));
+    assert!(close(cw.offset[0], -0.5, 1e-6), "{:?}", cw.offset);
+    assert!(best.note.is_some());
+    assert!(close(best.total_rms, G * 0.5 * mean_cos2.sqrt(), 1e-6));
+    assert!(best.lower_bound < 1e-3, "{}", best.lower_bound);
+}
+
+/// The two-link arm of `cases/two_link.json`: link 2 with its tool (2.5 kg at 0.3 m, 1 kg at
+/// 0.6 m) needs `m2·r2 = (−1.35, 0)` to take all gravity torque off the elbow. Naming the
+/// elbow alone, `m2` does exactly that; naming the shoulder alone the answer changes, and
+/// lowers the shoulder's torque below what the elbow's design leaves.
+#[test]
+fn two_link_joint_selection_changes_the_design() {
+    let model = model_of(&case("two_link.json"));
+    let qs = grid(&[spaced(-1.0, 1.0, 7), spaced(-1.5, 1.5, 7)]);
+    let limits = CounterweightLimits {
+        mass: [0.0, 20.0],
+        radius: [0.0, 1.0],
+    };
+    let elbow = search(&model, &qs, limits, 1, vec![1]);
+    let best = &elbow.designs[0];
+    assert_eq!(best.labels, ["m2"]);
+    assert!(
+        best.rms[1] < 1e-6 * elbow.unbalanced_rms[1],
+        "{:?}",
+        best.rms
+    );
+    let cw = &best.counterweights[0];
+    assert!(close(cw.mass * cw.offset[0], -1.35, 1e-6), "{cw:?}");
+    assert!((cw.mass * cw.offset[1]).abs() < 1e-6, "{cw:?}");
+
+    let shoulder = search(&model, &qs, limits, 1, vec![0]);
+    let best_shoulder = &shoulder.designs[0];
+    assert!(
+        best_shoulder.rms[0] < best.rms[0] * 0.9,
+        "shoulder {:?} vs elbow's design {:?}",
+        best_shoulder.rms,
+        best.rms
+    );
+    // Each design recomputed from the kinematics.
+    for d in [best, best_shoulder] {
+        let rms = recomputed_rms(&model, &qs, d);
+        for (a, b) in rms.iter().zip(&d.rms) {
+            assert!(close(*a, *b, 1e-9), "{rms:?} vs {:?}", d.rms);
+        }
+    }
+    // Both joints, two elements: the whole arm balances (m1 takes the shoulder's rest).
+    let both = search(&model, &qs, limits, 2, vec![0, 1]);
+    assert!(both.designs[0].total_rms < 1e-6 * both.unbalanced_total);
+    assert_eq!(both.designs[0].labels, ["m1", "m2"]);
+}
+
+/// The conic optimum against dense normal equations over torques computed independently (per
+/// unit mass and per unit moment, from the kinematics), on the 6-axis arm of `cases/arm6.json`
+/// with the shoulder and elbow named: the conic residual is never below the unconstrained
+/// least-squares one, and equal to it when the conic design is strictly inside its bounds.
+#[test]
+fn arm6_conic_optimum_matches_the_normal_equations() {
+    let model = model_of(&case("arm6.json"));
+    // shoulder_lift and elbow over their task range, the first wrist at two values.
+    let qs = grid(&[
+        vec![0.3],
+        spaced(-3.1, 3.1, 7),
+        spaced(-3.1, 3.1, 7),
+        vec![-1.0, 0.5],
+        vec![0.0],
+        vec![0.0],
+    ]);
+    let joints = vec![1, 2];
+    let limits = CounterweightLimits {
+        mass: [0.0, 1e3],
+        radius: [0.0, 10.0],
+    };
+    // The least residual alone: the lightest design of the same residual is on the bounds.
+    let report = search_with(
+        &model,
+        &qs,
+        limits,
+        PartialOptions {
+            lightest: false,
+            ..PartialOptions::new(2, joints.clone())
+        },
+    );
+    let energy = mechanism_energy(&model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+    let unbalanced: Vec<DVector<f64>> = qs.iter().map(|q| static_forces(&model, q, &[])).collect();
+    let mut checked = 0;
+    for design in &report.designs {
+        // Columns: per counterweight, m at the origin and unit moments along x, y, z.
+        let mut columns: Vec<Vec<f64>> = Vec::new();
+        for c in &design.counterweights {
+            for r in [Vector3::zeros(), Vector3::x(), Vector3::y(), Vector3::z()] {
+                let mut col = Vec::new();
+                for (q, ub) in qs.iter().zip(&unbalanced) {
+                    let f = static_forces(&model, q, &[(c.body, 1.0, r)]) - ub;
+                    col.extend(joints.iter().map(|&j| f[j]));
+                }
+                columns.push(col);
+            }
+        }
+        let rows = qs.len() * joints.len();
+        // Unit mass at r is m + μ: the moment columns are the differences.
+        let a = DMatrix::from_fn(rows, columns.len(), |r, c| {
+            if c % 4 == 0 {
+                columns[c][r]
+            } else {
+                columns[c][r] - columns[c - c % 4][r]
+            }
+        });
+        let b = DVector::from_iterator(
+            rows,
+            unbalanced
+                .iter()
+                .flat_map(|ub| joints.iter().map(move |&j| -ub[j])),
+        );
+        // Normal equations AᵀA x = Aᵀb, with a pseudo-inverse for the columns that do
+        // nothing (a mass on a fixed point, a moment along a joint axis).
+        let ata = a.transpose() * &a;
+        let atb = a.transpose() * &b;
+        let x = ata.clone().pseudo_inverse(1e-10 * ata.amax()).unwrap() * atb;
+        let residual = ((&a * &x) - &b).norm() / (qs.len() as f64).sqrt();
+        // The conic design strictly inside its bounds: then it is a minimum of the
+        // unconstrained convex quadratic too, so both methods must reach the same residual.
+        let inside = design.counterweights.iter().all(|c| {
+            let r = c.offset.iter().map(|v| v * v).sum::<f64>().sqrt();
+            c.mass > 1e-3 && c.mass < 1e3 * (1.0 - 1e-6) && r < 10.0 * (1.0 - 1e-6)
+        });
+        assert!(
+            design.total_rms >= residual * (1.0 - 1e-6) - 1e-9,
+            "{:?}: {} < {residual}",
+            design.labels,
+            design.total_rms
+        );
+        if inside {
+            assert!(
+                close(design.total_rms, residual, 1e-6),
+                "{:?}: conic {} vs normal equations {residual}",
+                design.labels,
+                design.total_rms
+            );
+            checked += 1;
+        }
+        let rms = recomputed_rms(&model, &qs, design);
+        for j in &joints {
+            assert!(
+                close(rms[*j], design.rms[*j], 1e-9),
+                "{rms:?} vs {:?} {design:?}",
+                design.rms
+            );
+        }
+    }
+    // m2 + m3 and m1 + m2 (the shoulder's counterweight sits on the axis and is free).
+    assert!(checked >= 2, "only {checked} sets had an interior optimum");
+    assert_eq!(catalogue.counts().0, 6);
+}
+
+/// The ranking is by total residual, and the answer does not depend on the thread count.
+#[test]
+fn ranking_is_ordered_and_thread_independent() {
+    let model = model_of(&case("two_link.json"));
+    let qs = grid(&[spaced(-1.0, 1.0, 5), spaced(-1.5, 1.5, 5)]);
+    let limits = CounterweightLimits {
+        mass: [0.0, 2.0],
+        radius: [0.0, 0.3],
+    };
+    let many = search(&model, &qs, limits, 2, vec![0, 1]);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let one = pool.install(|| search(&model, &qs, limits, 2, vec![0, 1]));
+    assert_eq!(many.designs.len(), 3);
+    for w in many.designs.windows(2) {
+        assert!(w[0].total_rms <= w[1].total_rms);
+    }
+    for (a, b) in many.designs.iter().zip(&one.designs) {
+        assert_eq!(a.labels, b.labels);
+        assert_eq!(a.total_rms.to_bits(), b.total_rms.to_bits());
+    }
+    // Bounds respected by every design.
+    for d in &many.designs {
+        for c in &d.counterweights {
+            let r = c.offset.iter().map(|v| v * v).sum::<f64>().sqrt();
+            assert!(c.mass <= 2.0 * (1.0 + 1e-7) && c.mass >= -1e-9, "{c:?}");
+            assert!(r <= 0.3 * (1.0 + 1e-6), "{c:?}");
+        }
+    }
+}
