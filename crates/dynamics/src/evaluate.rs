@@ -76,6 +76,25 @@ impl Default for EvaluateOptions {
     }
 }
 
+/// How the outputs of a batch's columns are computed by the grid evaluation.
+///
+/// Both give the same values to rounding (`tests/superposition.rs` of the dynamics crate: the
+/// palletizer's joint reaction peaks to 1e-9 relative); each is deterministic per column,
+/// whatever else is in the batch. A study uses one of them throughout, so that its shards
+/// merge into the single run's bits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Combination {
+    /// Every column through the reaction solve of its own right-hand side (and its inertia
+    /// group's changes with the rotation speed).
+    #[default]
+    Direct,
+    /// The model's own parameters and one unit column per lifted row that any column changes
+    /// are solved; each column is the model's outputs plus its elements' rows times their unit
+    /// outputs, its own rows in ascending order. Cheaper once the batch has more columns than
+    /// rows (Dmax 3 and up), and the way to evaluate one variant's many spring options.
+    Superposition,
+}
+
 /// Tasks left out of the indicators.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Excluded {
@@ -187,6 +206,7 @@ pub fn evaluate_grid(
             &tasks,
             params,
             options.reactions,
+            Combination::Direct,
             crate::fast::GridSink::Table(&mut table),
         ),
         None => {
@@ -241,6 +261,17 @@ pub fn evaluate_grid_indicators(
     params: &ParameterSet,
     options: &EvaluateOptions,
 ) -> Result<GridIndicators, DynamicsError> {
+    evaluate_grid_indicators_with(model, params, options, Combination::Direct)
+}
+
+/// [`evaluate_grid_indicators`] with the columns combined as `combination` says (with the
+/// cyclic shortcut; the direct path over every task has no superposition).
+pub fn evaluate_grid_indicators_with(
+    model: &Model,
+    params: &ParameterSet,
+    options: &EvaluateOptions,
+    combination: Combination,
+) -> Result<GridIndicators, DynamicsError> {
     let (tasks, ev, cyclic) = grid_setup(model, params, options)?;
     let Some(cyc) = cyclic else {
         let grid = evaluate_grid(model, params, options)?;
@@ -263,6 +294,7 @@ pub fn evaluate_grid_indicators(
         &tasks,
         params,
         options.reactions,
+        combination,
         crate::fast::GridSink::Maxima(&mut maxima),
     );
     let indicators = maxima.finish(&ev.actuator_names(), &ev.joint_names(), |w| tasks.pair(w));

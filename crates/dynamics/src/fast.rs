@@ -40,6 +40,7 @@ use counterpoise_symbolic::MAX_VARS;
 use rayon::prelude::*;
 
 use crate::error::{FailureReason, TaskFailure};
+use crate::evaluate::Combination;
 use crate::indicators::{IndicatorAccumulator, StatsTable};
 use crate::kernel::{ColumnBatch, actuator_forces_batch, required_wrenches_batch};
 use crate::law::{quintic, quintic_move, sample_time};
@@ -69,6 +70,13 @@ struct Work {
     torques: Vec<f64>,
     /// Motor torques of the group representatives at `Δ = ±1`: `[Δ][actuator][group]`.
     rep_torques: Vec<f64>,
+    /// With [`Superposition`]: every column's motor torques, `[Δ][actuator][column]`, summed
+    /// from the basis columns' in `torques`.
+    sum_torques: Vec<f64>,
+    /// With [`Superposition`]: every column's reaction components, per component row
+    /// `[Δ = 0 | unused | change to +1 | change to −1]`, `cols` each (the layout of `out` with
+    /// every column its own group).
+    sum_out: Vec<f64>,
     /// Coefficients of the current sub-task, per sample (`stride` values): the motor torques
     /// as quadratics in `Δ` — three arrays `[actuator][column]` — then, with reactions,
     /// `|F_j|²` and `|M_j|²` as quartics — five arrays `[force/moment][joint][column]`.
@@ -156,6 +164,127 @@ impl InertiaGroups {
     }
 }
 
+/// Reactions (and torques) by superposition (`Combination::Superposition`).
+///
+/// Every output of a sample is linear in the column's lifted parameters `p`. A variant differs
+/// from the model's own parameters `p₀` (its bodies and payloads, no springs) in the rows of its
+/// few elements: a counterweight's body block, a spring's slot. So
+/// `X(p) = X(p₀) + Σ_r (p_r − p₀_r) X(e_r)`, summed over the rows `r` where `p` differs from
+/// `p₀`, with `e_r` the unit column of row `r`. Per sample the machinery evaluates `p₀` and the
+/// unit columns of every row in which some column of the batch differs (the basis), then each
+/// column is that sum — its own rows in ascending order, whatever else is in the batch, so a
+/// column's bits do not depend on the batch, the shard or the thread count.
+///
+/// The unit column of a body row is its own inertia group (the row is inertial); a spring
+/// row's unit column has no inertia and no change with `Δ` (springs are static), which the sum
+/// skips. A column is then its own group: its changes to `Δ = ±1` are summed like its values.
+struct Superposition {
+    /// `p₀` and the unit columns, in row order.
+    basis: ParameterSet,
+    groups: InertiaGroups,
+    /// Per basis column: whether it changes with `Δ` (`p₀` and the body rows).
+    inertial: Vec<bool>,
+    /// Per column: `(basis column, p_r − p₀_r)` over the rows where it differs, ascending.
+    terms: Vec<Vec<(u32, f64)>>,
+    /// Every column its own group.
+    identity: Vec<u32>,
+}
+
+impl Superposition {
+    fn new(base_bodies: &[f64], params: &ParameterSet) -> Superposition {
+        let rows = params.rows();
+        let inertial_rows = crate::params::BODY_PARAMS * params.bodies;
+        let mut base = base_bodies.to_vec();
+        base.resize(rows, 0.0);
+        let differs = |p: usize, r: usize| params.column(p)[r].to_bits() != base[r].to_bits();
+        let used: Vec<usize> = (0..rows)
+            .filter(|&r| (0..params.len()).any(|p| differs(p, r)))
+            .collect();
+        let mut basis = ParameterSet::empty(params.bodies, params.springs.clone());
+        basis
+            .push_column(&base)
+            .expect("a column of the set's own shape");
+        let mut inertial = vec![true];
+        let mut index = vec![u32::MAX; rows];
+        for &r in &used {
+            let mut unit = vec![0.0; rows];
+            unit[r] = 1.0;
+            basis
+                .push_column(&unit)
+                .expect("a column of the set's own shape");
+            index[r] = (basis.len() - 1) as u32;
+            inertial.push(r < inertial_rows);
+        }
+        let terms = (0..params.len())
+            .map(|p| {
+                used.iter()
+                    .filter(|&&r| differs(p, r))
+                    .map(|&r| (index[r], params.column(p)[r] - base[r]))
+                    .collect()
+            })
+            .collect();
+        Superposition {
+            groups: InertiaGroups::new(&basis),
+            basis,
+            inertial,
+            terms,
+            identity: (0..params.len() as u32).collect(),
+        }
+    }
+
+    /// Every column's torques `[Δ][actuator][column]` from the basis's `[Δ][actuator][basis]`.
+    fn torques(&self, basis: &[f64], n: usize, dst: &mut Vec<f64>) {
+        let (nb, cols) = (self.basis.len(), self.terms.len());
+        dst.resize(3 * n * cols, 0.0);
+        for da in 0..3 * n {
+            let src = &basis[da * nb..(da + 1) * nb];
+            for (d, terms) in dst[da * cols..(da + 1) * cols].iter_mut().zip(&self.terms) {
+                *d = terms
+                    .iter()
+                    .fold(src[0], |acc, &(k, c)| c.mul_add(src[k as usize], acc));
+            }
+        }
+    }
+
+    /// Every column's reaction components (the layout of `Work::sum_out`) from the basis's
+    /// (`out`, `solved` values per component row: the basis columns at `Δ = 0`, the groups at
+    /// `Δ = 0` (unused), their changes to `+1`, to `−1`).
+    fn reactions(&self, out: &[f64], solved: usize, component_rows: usize, dst: &mut Vec<f64>) {
+        let (nb, nreps, cols) = (
+            self.basis.len(),
+            self.groups.rep_batch.len(),
+            self.terms.len(),
+        );
+        let group = &self.groups.group;
+        dst.resize(component_rows * 4 * cols, 0.0);
+        for row in 0..component_rows {
+            let src = &out[row * solved..(row + 1) * solved];
+            let (at_zero, rest) = src.split_at(nb);
+            let changes = &rest[nreps..];
+            let (plus, minus) = changes.split_at(nreps);
+            let dst = &mut dst[row * 4 * cols..(row + 1) * 4 * cols];
+            let (d0, rest) = dst.split_at_mut(2 * cols);
+            let (dp, dm) = rest.split_at_mut(cols);
+            let g0 = group[0] as usize;
+            for (p, terms) in self.terms.iter().enumerate() {
+                d0[p] = terms.iter().fold(at_zero[0], |acc, &(k, c)| {
+                    c.mul_add(at_zero[k as usize], acc)
+                });
+                let (mut sp, mut sm) = (plus[g0], minus[g0]);
+                for &(k, c) in terms {
+                    if self.inertial[k as usize] {
+                        let g = group[k as usize] as usize;
+                        sp = c.mul_add(plus[g], sp);
+                        sm = c.mul_add(minus[g], sm);
+                    }
+                }
+                dp[p] = sp;
+                dm[p] = sm;
+            }
+        }
+    }
+}
+
 /// Outcome of one sub-task: the statistics of its distinct tasks and, per task, which one
 /// it is; or the failure of the sub-task.
 type SubTaskOutcome = Result<(TaskRows, Vec<(usize, usize)>), Vec<TaskFailure>>;
@@ -194,6 +323,7 @@ pub(crate) fn evaluate_cyclic(
     tasks: &TaskSet,
     params: &ParameterSet,
     with_reactions: bool,
+    combination: Combination,
     sink: GridSink,
 ) -> (Vec<TaskFailure>, usize) {
     let mech = &ev.mech;
@@ -287,6 +417,8 @@ pub(crate) fn evaluate_cyclic(
     };
     let per_sample_stride = params.len() * (3 * na + 10 * nj);
     let groups = InertiaGroups::new(params);
+    let superposition = (combination == Combination::Superposition)
+        .then(|| Superposition::new(&crate::params::model_body_params(ev.model), params));
     let one_sub_task = |work: &mut Work, st: usize, floor: Option<&[f64]>| -> SubTaskOutcome {
         let (s1, s2) = st_pairs[st];
         let data = match &sub_q[s1] {
@@ -301,6 +433,7 @@ pub(crate) fn evaluate_cyclic(
                 ns,
                 params,
                 &groups,
+                superposition.as_ref(),
                 with_reactions,
                 per_sample_stride,
                 work,
@@ -562,6 +695,7 @@ fn sub_task(
     ns: usize,
     params: &ParameterSet,
     groups: &InertiaGroups,
+    superposition: Option<&Superposition>,
     with_reactions: bool,
     stride: usize,
     work: &mut Work,
@@ -569,7 +703,18 @@ fn sub_task(
     let mech = &ev.mech;
     let n = mech.n;
     let l = mech.body_count;
+    // The columns evaluated: the batch's own, or the superposition's basis.
+    let (params_in, groups) = match superposition {
+        Some(sup) => (params, &sup.groups),
+        None => (params, groups),
+    };
+    let params = match superposition {
+        Some(sup) => &sup.basis,
+        None => params_in,
+    };
     let cols = params.len();
+    // The columns whose coefficients are stored.
+    let out_cols = params_in.len();
     let nj = if with_reactions {
         ev.reactions.joint_count()
     } else {
@@ -577,7 +722,7 @@ fn sub_task(
     };
     let rows = 6 * l;
     let tq = n * cols;
-    let rq = 2 * nj * cols;
+    let rq = 2 * nj * out_cols;
     let nreps = groups.rep_batch.len();
     // right-hand sides solved: every column at Δ = 0, the representatives at Δ = 0, ±1
     let solved = cols + 3 * nreps;
@@ -720,7 +865,8 @@ fn sub_task(
             );
         }
         work.scratch.pose = pose;
-        // Every column at Δ = ±1 from its representative: X_p(±1) = X_r(±1) + X_p(0) − X_r(0).
+        // Every (evaluated) column at Δ = ±1 from its representative:
+        // X_p(±1) = X_r(±1) + X_p(0) − X_r(0).
         {
             let (at_zero, at_pm) = work.torques.split_at_mut(tq);
             for si in 0..2 {
@@ -733,12 +879,33 @@ fn sub_task(
                 }
             }
         }
-        let mut finite = all_finite(&work.torques);
+        // The stored columns' values: the evaluated ones, or their sums over the basis.
+        let (torques, out, solved, nreps, group, cols) = match superposition {
+            Some(sup) => {
+                sup.torques(&work.torques, n, &mut work.sum_torques);
+                if with_reactions {
+                    sup.reactions(&work.out, solved, 6 * nj, &mut work.sum_out);
+                }
+                let c = out_cols;
+                let group = &sup.identity[..];
+                (&work.sum_torques[..], &work.sum_out[..], 4 * c, c, group, c)
+            }
+            None => (
+                &work.torques[..],
+                &work.out[..],
+                solved,
+                nreps,
+                &groups.group[..],
+                cols,
+            ),
+        };
+        let tq = n * cols;
+        let mut finite = all_finite(torques);
         if with_reactions {
             // every column at Δ = 0 and every group's change
             for row in 0..6 * nj {
-                finite &= all_finite(&work.out[row * solved..row * solved + cols]);
-                finite &= all_finite(&work.out[row * solved + cols + nreps..(row + 1) * solved]);
+                finite &= all_finite(&out[row * solved..row * solved + cols]);
+                finite &= all_finite(&out[row * solved + cols + nreps..(row + 1) * solved]);
             }
         }
         if !finite {
@@ -750,7 +917,7 @@ fn sub_task(
         let (torque_coefs, reaction_coefs) = dst.split_at_mut(3 * tq);
         let (tc0, rest) = torque_coefs.split_at_mut(tq);
         let (tc1, tc2) = rest.split_at_mut(tq);
-        let (x0, rest) = work.torques.split_at(tq);
+        let (x0, rest) = torques.split_at(tq);
         let (xp, xm) = rest.split_at(tq);
         quadratic_coefficients([x0, xp, xm], [tc0, tc1, tc2]);
         if with_reactions {
@@ -764,14 +931,14 @@ fn sub_task(
                     // the three components: every column at Δ = 0, the groups' changes to
                     // Δ = +1 and −1
                     let component = |r: usize| {
-                        let row = &work.out[(6 * j + 3 * part + r) * solved..][..solved];
+                        let row = &out[(6 * j + 3 * part + r) * solved..][..solved];
                         let (x0, rest) = row.split_at(cols);
                         let changes = &rest[nreps..];
                         let (plus, minus) = changes.split_at(nreps);
                         [x0, plus, minus]
                     };
                     squared_norm_quartic(
-                        &groups.group,
+                        group,
                         [component(0), component(1), component(2)],
                         [
                             &mut q0[slot.clone()],

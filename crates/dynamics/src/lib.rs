@@ -31,8 +31,9 @@ pub mod tasks;
 
 pub use error::{DynamicsError, FailureReason, TaskFailure};
 pub use evaluate::{
-    EvaluateOptions, EvaluationReport, Excluded, GridEvaluation, GridIndicators, JointSeries,
-    Series, evaluate, evaluate_grid, evaluate_grid_indicators, task_series, task_series_with,
+    Combination, EvaluateOptions, EvaluationReport, Excluded, GridEvaluation, GridIndicators,
+    JointSeries, Series, evaluate, evaluate_grid, evaluate_grid_indicators,
+    evaluate_grid_indicators_with, task_series, task_series_with,
 };
 pub use indicators::{ActuatorIndicators, Indicators, JointIndicators, TaskStats};
 pub use params::{Counterweight, ParameterSet, Spring, SpringSlot, Variant};
