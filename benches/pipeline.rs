@@ -1,0 +1,210 @@
+//! The pipeline a user runs, on the palletizer (`cases/palletizer.json`), as criterion benches:
+//!
+//! - `study/dmax2`: the whole `run` computation at Dmax 2 — Phase 1 (the unbalanced robot over
+//!   all 58,653 tasks, with reactions), the balance search, the optimisation of the 97 balanced
+//!   variants (critical-task loop, certified spring stage, spring choice, final all-task
+//!   evaluation with reactions); no report writing;
+//! - `variants/dmax3`, `variants/dmax4`: the exact balance search (`variants --dmax N`);
+//! - `grid/unbalanced_reactions`: the full-grid evaluation of the unbalanced robot with joint
+//!   reactions (Phase 1);
+//! - `final_grid/*`: the final all-task evaluation of the 50 feasible Dmax 2 designs, with the
+//!   reactions solved per variant (`direct`) and by superposition (`superposition`); and the
+//!   same on 400 synthetic three-element variants (a Dmax 3-sized batch) at 11 samples per
+//!   move, where superposition's fixed cost (one solve per lifted row the batch touches) is
+//!   spread over more columns.
+//!
+//! `cargo bench --bench pipeline` runs them all (10 samples each, about 8 minutes on two
+//! cores); `cargo bench --bench pipeline -- final_grid` one group. The medians are in the
+//! README's Performance section.
+
+use std::time::Duration;
+
+use counterpoise_balance::{
+    Catalogue, SearchOptions, Status, VariantResult, catalogue_options, mechanism_energy,
+    realization_hints, search,
+};
+use counterpoise_dynamics::params::ParameterSet;
+use counterpoise_dynamics::{
+    Combination, Counterweight, EvaluateOptions, Spring, Variant, evaluate_grid_indicators,
+    evaluate_grid_indicators_with,
+};
+use counterpoise_model::{Case, Model};
+use counterpoise_optimise::{Context, OptimiseOptions, OptimisedVariant, optimise_all};
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn palletizer() -> Model {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/palletizer.json");
+    Case::from_path(&path).expect("the palletizer case loads")
+}
+
+fn balanced(model: &Model, dmax: usize) -> Vec<VariantResult> {
+    let energy = mechanism_energy(model);
+    search(
+        &energy,
+        Catalogue::build(&energy, &catalogue_options(model)),
+        SearchOptions {
+            dmax,
+            hints: realization_hints(model),
+        },
+    )
+    .variants
+    .into_iter()
+    .filter(|v| v.status == Status::Balanced)
+    .collect()
+}
+
+/// Phase 1, the search and the optimisation, as `run` chains them.
+fn study(model: &Model, dmax: usize) -> Vec<OptimisedVariant> {
+    let mut ub = evaluate_grid_indicators(
+        model,
+        &ParameterSet::unbalanced(model),
+        &EvaluateOptions::default(),
+    )
+    .expect("phase 1");
+    let variants = balanced(model, dmax);
+    let ctx = Context::new(model, Some(ub.indicators.swap_remove(0))).expect("context");
+    optimise_all(&ctx, &variants, &OptimiseOptions::default())
+}
+
+/// The dynamics crate's variant of an optimised record.
+fn variant(model: &Model, o: &OptimisedVariant) -> Variant {
+    let body = |name: &str| model.body_index(name).expect("a body of the model");
+    Variant {
+        counterweights: o
+            .counterweights
+            .iter()
+            .map(|c| Counterweight {
+                body: body(&c.body),
+                mass: c.mass,
+                position: c.offset,
+            })
+            .collect(),
+        springs: o
+            .springs
+            .iter()
+            .map(|s| Spring {
+                body: body(&s.body),
+                other: (s.other != "base").then(|| body(&s.other)),
+                stiffness: s.stiffness,
+                anchor: s.anchor_a,
+                other_anchor: s.anchor_b,
+            })
+            .collect(),
+    }
+}
+
+/// `count` three-element variants over the bodies and spring slots of the palletizer's
+/// feasible designs (a counterweight on one of 5 members and two springs, or two
+/// counterweights and one spring), every element with its own parameters, as the finalists of
+/// a Dmax 3 study have.
+fn synthetic_dmax3(model: &Model, finals: &[Variant], count: usize) -> Vec<Variant> {
+    let cw_bodies: Vec<usize> = {
+        let mut b: Vec<usize> = finals
+            .iter()
+            .flat_map(|v| v.counterweights.iter().map(|c| c.body))
+            .collect();
+        b.sort_unstable();
+        b.dedup();
+        b
+    };
+    let springs: Vec<Spring> = finals.iter().flat_map(|v| v.springs.clone()).collect();
+    assert!(!cw_bodies.is_empty() && !springs.is_empty() && model.bodies.len() > 1);
+    (0..count)
+        .map(|k| {
+            let scale = 1.0 + 0.001 * k as f64;
+            let cw = |i: usize| Counterweight {
+                body: cw_bodies[(k + i) % cw_bodies.len()],
+                mass: 50.0 * scale + 10.0 * i as f64,
+                position: [-0.3 * scale, 0.02 * i as f64, 0.0],
+            };
+            let spring = |i: usize| {
+                let mut s = springs[(3 * k + 7 * i) % springs.len()];
+                s.stiffness *= scale;
+                s
+            };
+            if k % 2 == 0 {
+                Variant {
+                    counterweights: vec![cw(0)],
+                    springs: vec![spring(0), spring(1)],
+                }
+            } else {
+                Variant {
+                    counterweights: vec![cw(0), cw(1)],
+                    springs: vec![spring(0)],
+                }
+            }
+        })
+        .collect()
+}
+
+fn pipeline(c: &mut Criterion) {
+    let model = palletizer();
+
+    let mut group = c.benchmark_group("study");
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_secs(1));
+    group.measurement_time(Duration::from_secs(60));
+    group.bench_function("dmax2", |b| b.iter(|| study(&model, 2)));
+    group.finish();
+
+    let mut group = c.benchmark_group("variants");
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_secs(1));
+    group.measurement_time(Duration::from_secs(5));
+    group.bench_function("dmax3", |b| b.iter(|| balanced(&model, 3)));
+    group.measurement_time(Duration::from_secs(30));
+    group.bench_function("dmax4", |b| b.iter(|| balanced(&model, 4)));
+    group.finish();
+
+    let mut group = c.benchmark_group("grid");
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_secs(1));
+    group.measurement_time(Duration::from_secs(15));
+    let ub = ParameterSet::unbalanced(&model);
+    group.bench_function("unbalanced_reactions", |b| {
+        b.iter(|| evaluate_grid_indicators(&model, &ub, &EvaluateOptions::default()))
+    });
+    group.finish();
+
+    // The Dmax 2 designs, optimised once.
+    let finals: Vec<Variant> = study(&model, 2)
+        .iter()
+        .filter(|o| o.is_feasible())
+        .map(|o| variant(&model, o))
+        .collect();
+    let params = ParameterSet::from_variants(&model, &finals).expect("variants");
+    let mut group = c.benchmark_group("final_grid");
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_secs(1));
+    group.measurement_time(Duration::from_secs(30));
+    let options = EvaluateOptions::default();
+    for (name, combination) in [
+        ("dmax2_direct", Combination::Direct),
+        ("dmax2_superposition", Combination::Superposition),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| evaluate_grid_indicators_with(&model, &params, &options, combination))
+        });
+    }
+    let synthetic = synthetic_dmax3(&model, &finals, 400);
+    let params = ParameterSet::from_variants(&model, &synthetic).expect("variants");
+    let options = EvaluateOptions {
+        samples: Some(11),
+        ..EvaluateOptions::default()
+    };
+    for (name, combination) in [
+        ("synthetic400_11samples_direct", Combination::Direct),
+        (
+            "synthetic400_11samples_superposition",
+            Combination::Superposition,
+        ),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| evaluate_grid_indicators_with(&model, &params, &options, combination))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, pipeline);
+criterion_main!(benches);
