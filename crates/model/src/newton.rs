@@ -273,4 +273,22 @@ mod tests {
             Err(KinematicsError::Singular { condition, .. }) if condition == f64::INFINITY
         ));
     }
+
+    /// The condition number is the singular values' ratio computed to nalgebra's default
+    /// tolerance. G = [[1, 5], [0, 1]] is already bidiagonal: its diagonal (1, 1) would give a
+    /// condition of 1 with a tolerance loose enough to accept the off-diagonal 5 as zero.
+    /// By hand: σ_max·σ_min = |det G| = 1 and σ_max² + σ_min² = ‖G‖_F² = 27, so the condition
+    /// σ_max/σ_min = σ_max² = (27 + √725)/2 ≈ 26.96: singular at a limit of 10, not at 30.
+    #[test]
+    fn the_condition_number_is_the_converged_singular_values_ratio() {
+        let g = DMatrix::from_row_slice(2, 2, &[1.0, 5.0, 0.0, 1.0]);
+        let exact = (27.0 + 725f64.sqrt()) / 2.0;
+        match checked_lu(&g, &q(), 10.0) {
+            Err(KinematicsError::Singular { condition, .. }) => {
+                assert!((condition - exact).abs() <= 1e-12 * exact, "{condition}")
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(checked_lu(&g, &q(), 30.0).is_ok());
+    }
 }
