@@ -165,6 +165,10 @@ enum Command {
         /// default: the one of the run).
         #[arg(long, value_name = "PP", value_parser = parse_points)]
         tolerance: Option<f64>,
+        /// Also draw this variant's schematic (its name, `SB12`, or its elements, `m4 + K43`;
+        /// repeatable). The recommended variants are always drawn.
+        #[arg(long, value_name = "VARIANT")]
+        draw: Vec<String>,
     },
 }
 
@@ -311,7 +315,11 @@ fn run(cli: Cli) -> ExitCode {
                 progress: commands::progress::Progress::detect(quiet, 3),
             },
         ),
-        Command::Report { dir, tolerance } => commands::report(&dir, tolerance),
+        Command::Report {
+            dir,
+            tolerance,
+            draw,
+        } => commands::report::run(&dir, tolerance, &draw),
         Command::ImportUrdf {
             urdf,
             out,

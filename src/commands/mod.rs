@@ -1,10 +1,12 @@
 //! One module per subcommand.
 
 pub mod check;
+pub mod design;
 pub mod evaluate;
 pub mod import_urdf;
 pub mod merge;
 pub mod progress;
+pub mod report;
 pub mod run;
 pub mod shard_file;
 pub mod states;
@@ -61,16 +63,6 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
     std::fs::rename(&tmp, path)
         .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
     Ok(())
-}
-
-/// `counterpoise report DIR`: rewrites the reports from `DIR/results.json`, with the decision
-/// recomputed at `tolerance` when one is given.
-pub fn report(dir: &Path, tolerance: Option<f64>) -> Result<std::process::ExitCode> {
-    let written = counterpoise_report::regenerate_with(dir, tolerance)?;
-    for f in written {
-        println!("wrote {}", f.display());
-    }
-    Ok(std::process::ExitCode::SUCCESS)
 }
 
 /// The guards of `run`, before its first stage: the variant count and the paths (a path found

@@ -422,6 +422,7 @@ pub fn finish(
             .push(record(model, id, v, opt, ub_grid_info));
     }
     results.moving_mass = Some(model.bodies.iter().map(|b| b.mass).sum());
+    results.element_bounds = super::design::element_bounds(model)?;
     timer.time("Phase 3: ranking, torque curves, path", || {
         results.finalize(&study.ranking)?;
         // The recommendation reads the practical figures, and the charts show it: figures
@@ -439,6 +440,7 @@ pub fn finish(
             results.path = Some(path_simulation(model, &mechanisms, 0)?.0);
         }
         results.finalize(&study.ranking)?;
+        results.schematics = super::design::schematics(model, &results, &[])?;
         Ok(())
     })?;
     results.metadata.timings = timer.timings;

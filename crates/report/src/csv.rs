@@ -6,7 +6,7 @@ use crate::format::csv_field;
 use crate::results::RunResults;
 
 /// Column names, in order.
-pub const HEADER: [&str; 22] = [
+pub const HEADER: [&str; 23] = [
     "rank",
     "class_rank",
     "name",
@@ -29,6 +29,7 @@ pub const HEADER: [&str; 22] = [
     "iterations",
     "verification_residual",
     "tie_broken_by_label",
+    "idle_elements",
 ];
 
 /// Renders the CSV (header line included).
@@ -64,6 +65,8 @@ pub fn render(r: &RunResults) -> String {
             o.iterations.map(|x| x.to_string()).unwrap_or_default(),
             num(v.verification_residual),
             v.tie_broken_by_label.to_string(),
+            // Space-separated labels of the elements that only idle (crate::honest).
+            v.idle.join(" "),
         ];
         let line: Vec<String> = fields.iter().map(|f| csv_field(f)).collect();
         s.push_str(&line.join(","));

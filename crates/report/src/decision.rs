@@ -21,6 +21,10 @@
 //!    lighter (a variant without springs has 0);
 //! 5. best rank.
 //!
+//! A variant holding an idle element ([`crate::honest`]) is never a candidate: it is really
+//! the smaller variant its working elements make. When every equivalent variant holds one,
+//! the scope's best-ranked variant without one is recommended, and the reason says so.
+//!
 //! The reason sentence names the steps that removed a candidate. A variant without practical
 //! figures (a results document built by hand) counts as 0 kg, 0 N.
 
@@ -152,7 +156,20 @@ fn recommend(
         .filter(|m| *m > 0.0)
         .map_or(MASS_MARGIN_KG, |m| m * MASS_MARGIN_PERCENT / 100.0);
     let mut steps: Vec<String> = Vec::new();
-    let mut left = equivalent.clone();
+    // Never a variant holding an idle element (crate::honest): it is really a smaller variant,
+    // and recommending it would recommend a part that does nothing. When every equivalent
+    // variant holds one, the best-ranked working variant of the scope is the fallback.
+    let working = |v: &&VariantRecord| v.idle.is_empty();
+    let idle_left_out = equivalent.iter().filter(|v| !working(v)).count();
+    let mut left: Vec<&VariantRecord> = equivalent.iter().copied().filter(working).collect();
+    let mut fallback = false;
+    if left.is_empty() {
+        left.extend(scope.iter().copied().find(working));
+        fallback = true;
+    }
+    if left.is_empty() {
+        return None;
+    }
     // 1. added mass
     let best = left
         .iter()
@@ -216,7 +233,15 @@ fn recommend(
         Some(Class::Springs) => " spring-only",
         Some(Class::Hybrid) => " hybrid",
     };
-    let reason = if equivalent.len() == 1 {
+    let reason = if fallback {
+        format!(
+            "Every{scope_name} variant within {} percentage points of {}'s ΔQTR and ΔQIT holds \
+             an idle element; {} is the best-ranked one without.",
+            trim(tolerance),
+            leader.name.clone().unwrap_or_else(|| leader.label()),
+            who(chosen)
+        )
+    } else if equivalent.len() == 1 {
         format!(
             "{} is the only{scope_name} variant within {} percentage points of the best ΔQTR and ΔQIT.",
             who(chosen),
@@ -239,6 +264,14 @@ fn recommend(
             who(chosen),
             join_steps(&steps)
         )
+    };
+    let reason = if idle_left_out > 0 && !fallback {
+        format!(
+            "{reason} ({idle_left_out} equivalent variant{} holding an idle element left out.)",
+            if idle_left_out == 1 { "" } else { "s" }
+        )
+    } else {
+        reason
     };
     Some(Recommendation {
         class,

@@ -234,6 +234,21 @@ fn push_decision(h: &mut String, r: &RunResults, charts: &[Chart]) {
         let _ = write!(h, "<li><b>{}.</b> {}</li>", esc(&scope), esc(&reason));
     }
     h.push_str("</ul>");
+    push_schematics(h, r);
+    let specs = tables::spring_specs(r);
+    if !specs.rows.is_empty() {
+        h.push_str("<h3>Spring specifications</h3>");
+        h.push_str(&table(&specs, ""));
+        let _ = write!(
+            h,
+            "<p class=\"note\">Each spring has zero free length in the model (force K·L at anchor distance L). Length: the shortest and longest anchor distance, {}. <b>Cable and pulley</b>: an extension spring of rate K beyond a pulley at anchor b, the cable from anchor a over the pulley, so the spring extends by the anchor distance; the pulley's axle carries up to twice the peak force. <b>Pre-tensioned</b>: an extension spring of body length L₀ coiled with initial tension K·L₀ pulls K·L for every L ≥ L₀; L₀ is the shortest length or a quarter of the longest, whichever is smaller (initial tension assumed achievable up to a quarter of the peak force), and “no room” means the anchors come within 5 % of the longest length of each other. Wire: the least mass of spring steel that stores ½·K·L_max² ({} J/kg at 700 MPa working shear stress, Wahl factor 1.2). A first sizing; the assumptions are in the README.</p>",
+            esc(r
+                .spring_peaks_basis
+                .as_deref()
+                .unwrap_or("over the configurations checked")),
+            crate::format::fixed(crate::springspec::WIRE_ENERGY_PER_KG, 0)
+        );
+    }
     let _ = write!(h, "<p class=\"note\"><b>Rule.</b> {}</p>", esc(&d.rule));
     h.push_str(&practical_note(r));
     push_charts(h, charts, Section::Decision);
@@ -248,6 +263,23 @@ fn push_decision(h: &mut String, r: &RunResults, charts: &[Chart]) {
         h.push_str(&table(&group, ""));
         h.push_str("</details>");
     }
+}
+
+/// The drawings of the recommended variants (and of those `report --draw` named).
+fn push_schematics(h: &mut String, r: &RunResults) {
+    let drawn: Vec<_> = r
+        .schematics
+        .iter()
+        .filter_map(|s| r.variant(s.variant).map(|v| (v, s)))
+        .collect();
+    if drawn.is_empty() {
+        return;
+    }
+    h.push_str("<h3>What they look like</h3><div class=\"charts\">");
+    for (v, s) in drawn {
+        let _ = write!(h, "<figure>{}</figure>", crate::schematic::svg(r, v, s));
+    }
+    h.push_str("</div><p class=\"note\">Bodies (grey bars from the joint each hangs from to its other joints and its centre of mass, a dot), joints (open circles, hatched where on the base), counterweights (blue discs at their centre of mass, area growing with the mass: the volume of a disc of the same material), springs (green zig-zags between their anchors, dashed to the joint of the body each anchor is on). Drawn from the model's kinematics, orthographic, in the vertical plane the mechanism spreads in most; up is against gravity.</p>");
 }
 
 /// Where the practical figures come from.

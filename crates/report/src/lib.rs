@@ -43,7 +43,9 @@
 //!
 //! Modules, one job each: [`indicators`] (Eqs. 15–21), [`ranking`] (lexicographic order at a
 //! resolution), [`practical`] (added mass, element count, spring and offset peaks),
-//! [`decision`] (equivalence groups and recommendations), [`results`] (the schema and
+//! [`decision`] (equivalence groups and recommendations), [`honest`] (idle elements,
+//! parameters on a bound), [`schematic`] (drawings of variants), [`springspec`] (what to order
+//! for each spring), [`results`] (the schema and
 //! `finalize`), [`tables`] (the tables both reports
 //! share), [`svg`] (hand-written charts), [`charts`] (which charts), [`html`], [`markdown`],
 //! [`csv`], [`text`] (terminal summary), [`output`] (atomic files), [`format`] (numbers and
@@ -53,6 +55,7 @@ pub mod charts;
 pub mod csv;
 pub mod decision;
 pub mod format;
+pub mod honest;
 pub mod html;
 pub mod indicators;
 pub mod markdown;
@@ -60,16 +63,20 @@ pub mod output;
 pub mod practical;
 pub mod ranking;
 pub mod results;
+pub mod schematic;
+pub mod springspec;
 pub mod svg;
 pub mod tables;
 pub mod text;
 
 pub use decision::{Decision, Recommendation, decide};
+pub use honest::ElementBounds;
 pub use indicators::{
     DeltaR, IndicatorError, JointReaction, JointVariation, delta_r, percent_variation,
 };
 pub use output::{
     OutputError, read_results, regenerate, regenerate_with, write_atomic, write_outputs,
+    write_reports,
 };
 pub use practical::{PracticalFigures, SpringPeak};
 pub use ranking::{Class, RankItem, Ranking, RankingError, RankingOptions, rank};
@@ -80,3 +87,4 @@ pub use results::{
     RunResults, SCHEMA_VERSION, SpringParams, StatusCount, TaskRef, TorqueChart, VariantRecord,
     VariantStatus,
 };
+pub use schematic::{DrawnBody, DrawnCounterweight, DrawnJoint, DrawnSpring, Schematic};

@@ -81,8 +81,9 @@ pub fn write_outputs(dir: &Path, results: &RunResults) -> Result<Vec<PathBuf>, O
     Ok(written)
 }
 
-/// Writes the three reports (not results.json).
-fn write_reports(dir: &Path, results: &RunResults) -> Result<Vec<PathBuf>, OutputError> {
+/// Writes the three reports (not results.json): `counterpoise report DIR`, after it has added
+/// what it computes from the case echo.
+pub fn write_reports(dir: &Path, results: &RunResults) -> Result<Vec<PathBuf>, OutputError> {
     Ok(vec![
         write_atomic(dir, REPORT_HTML, html::render(results).as_bytes())?,
         write_atomic(dir, REPORT_MD, markdown::render(results).as_bytes())?,

@@ -20,6 +20,10 @@ pub struct SpringPeak {
     pub elongation: f64,
     /// `K · elongation`, N.
     pub force: f64,
+    /// Smallest anchor-to-anchor distance over the same configurations, m (absent in results
+    /// written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shortest: Option<f64>,
 }
 
 impl SpringPeak {
@@ -30,14 +34,13 @@ impl SpringPeak {
         stiffness: f64,
         lengths: impl IntoIterator<Item = f64>,
     ) -> SpringPeak {
-        let elongation = lengths
-            .into_iter()
-            .filter(|l| l.is_finite())
-            .fold(0.0f64, f64::max);
+        let finite: Vec<f64> = lengths.into_iter().filter(|l| l.is_finite()).collect();
+        let elongation = finite.iter().copied().fold(0.0f64, f64::max);
         SpringPeak {
             label: label.to_string(),
             elongation,
             force: stiffness * elongation,
+            shortest: finite.iter().copied().reduce(f64::min),
         }
     }
 }
@@ -120,6 +123,7 @@ mod tests {
         // lengths 0.25, 0.6, 0.4 m: the peak is 0.6 m, 2000 N/m · 0.6 m = 1200 N
         let peak = SpringPeak::from_lengths("K43", 2000.0, [0.25, 0.6, f64::NAN, 0.4]);
         assert_eq!(peak.elongation, 0.6);
+        assert_eq!(peak.shortest, Some(0.25));
         assert!((peak.force - 1200.0).abs() < 1e-9);
         let f = PracticalFigures::new(&p, Some(120.0), vec![peak]);
         assert_eq!(f.added_mass, 30.0);

@@ -19,9 +19,11 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::decision::{Decision, decide};
+use crate::honest::{ElementBounds, idle_elements};
 use crate::indicators::{DeltaR, IndicatorError, JointReaction, delta_r, percent_variation};
 use crate::practical::PracticalFigures;
 use crate::ranking::{Class, RankItem, RankingError, RankingOptions, rank};
+use crate::schematic::Schematic;
 
 /// Version of the results.json layout.
 /// Version 2 added the practical figures (`practical`), the moving mass and the decision.
@@ -332,6 +334,9 @@ pub struct VariantRecord {
     /// True when the rank was decided by the element labels (tied on all three criteria).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub tie_broken_by_label: bool,
+    /// Labels of the elements that only idle (see [`crate::honest`]); filled by `finalize`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub idle: Vec<String>,
 }
 
 impl VariantRecord {
@@ -358,6 +363,7 @@ impl VariantRecord {
             rank: None,
             class_rank: None,
             tie_broken_by_label: false,
+            idle: Vec::new(),
         }
     }
 
@@ -553,6 +559,14 @@ pub struct RunResults {
     /// Equivalence groups and recommendations (filled by `finalize`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub decision: Option<Decision>,
+    /// The bounds each element was optimised within, to mark parameters on a bound (filled
+    /// by the caller; see [`crate::honest`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub element_bounds: Vec<ElementBounds>,
+    /// Drawings of the recommended variants and of any the user named (`report --draw`),
+    /// geometry from the model's kinematics (filled by the caller; see [`crate::schematic`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub schematics: Vec<Schematic>,
 }
 
 impl RunResults {
@@ -571,6 +585,8 @@ impl RunResults {
             moving_mass: None,
             spring_peaks_basis: None,
             decision: None,
+            element_bounds: Vec::new(),
+            schematics: Vec::new(),
         }
     }
 
@@ -641,6 +657,7 @@ impl RunResults {
                 .map(|g| g.iter().map(|&k| self.variants[ranked[k]].id).collect())
                 .collect(),
         });
+        self.mark_idle();
         self.decision = Some(decide(&self.ranked(), options.tolerance, self.moving_mass));
         if let Some(path) = &mut self.path {
             path.table = match &path.dynamic_run {
@@ -653,7 +670,43 @@ impl RunResults {
 
     /// Recomputes only the decision, at another tolerance (`counterpoise report --tolerance`).
     pub fn redecide(&mut self, tolerance: f64) {
+        self.mark_idle();
         self.decision = Some(decide(&self.ranked(), tolerance, self.moving_mass));
+    }
+
+    /// Marks the idle elements of every feasible variant ([`crate::honest`]).
+    pub fn mark_idle(&mut self) {
+        let g = self.gravity();
+        let moving_mass = self.moving_mass;
+        for v in &mut self.variants {
+            v.idle = match (&v.parameters, v.status) {
+                (Some(p), VariantStatus::Feasible) => {
+                    idle_elements(p, v.practical.as_ref(), moving_mass, g)
+                }
+                _ => Vec::new(),
+            };
+        }
+    }
+
+    /// |g| of the case echo, m/s² (9.81 when the echo has none).
+    pub fn gravity(&self) -> f64 {
+        let g: Option<f64> = self
+            .case
+            .get("gravity")
+            .and_then(|g| g.as_array())
+            .map(|a| {
+                a.iter()
+                    .filter_map(|x| x.as_f64())
+                    .map(|x| x * x)
+                    .sum::<f64>()
+                    .sqrt()
+            });
+        g.filter(|g| *g > 0.0 && g.is_finite()).unwrap_or(9.81)
+    }
+
+    /// The bounds of element `label`, when recorded.
+    pub fn bounds_of(&self, label: &str) -> Option<&ElementBounds> {
+        self.element_bounds.iter().find(|b| b.label == label)
     }
 
     /// Feasible variants in global rank order (after `finalize`).

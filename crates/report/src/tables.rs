@@ -2,7 +2,9 @@
 //! writers, so the two reports can never disagree on a number.
 
 use crate::format::{angle, compact, fixed, percent, polar, seconds, task, value};
+use crate::honest::on_bound;
 use crate::results::{PathSimulation, RunResults, VariantRecord, VariantStatus};
+use crate::springspec::SpringSpec;
 
 /// One cell: text, whether it is a number (right-aligned) and whether it is prose that may wrap
 /// (everything else stays on one line, so labels like `K42 + K43` never break).
@@ -286,11 +288,7 @@ pub fn ranking(r: &RunResults) -> Table {
                 Cell::num(opt(practical.and_then(|p| p.peak_spring_force), value)),
                 Cell::num(opt(optim.and_then(|o| o.objective), value)),
                 Cell::num(opt(optim.and_then(|o| o.gap), |g| format!("{:.1e}", g))),
-                Cell::text(if v.tie_broken_by_label {
-                    "label tie-break"
-                } else {
-                    ""
-                }),
+                Cell::text(note(v)),
             ],
             false,
             recommended.contains(&v.id),
@@ -299,31 +297,69 @@ pub fn ranking(r: &RunResults) -> Table {
     t.without_empty_columns()
 }
 
+/// The Note column of the ranking: an idle element and the variant it really is, then a
+/// rank decided by the labels.
+fn note(v: &VariantRecord) -> String {
+    let mut parts: Vec<String> = v.idle_note().into_iter().collect();
+    if v.tie_broken_by_label {
+        parts.push("label tie-break".into());
+    }
+    parts.join("; ")
+}
+
 /// The paper's Table 1: optimised parameters of the feasible variants, one row per element,
-/// in the paper's units (N/mm, mm, rad, kg).
+/// in the paper's units (N/mm, mm, kg) with angles in radians and degrees. A value on a bound
+/// of the optimisation carries `(min)` or `(max)`; an idle element ([`crate::honest`]) says so
+/// in the Element column.
 pub fn parameters(r: &RunResults) -> Table {
+    parameters_of(r, &r.ranked())
+}
+
+/// [`parameters`] for the given variants only.
+pub fn parameters_of(r: &RunResults, variants: &[&VariantRecord]) -> Table {
     let mut t = Table::new(&[
-        "Variant", "Element", "Bodies", "K [N/mm]", "a [mm]", "α [rad]", "b [mm]", "β [rad]",
-        "m [kg]", "r [mm]", "φ [rad]",
+        "Variant",
+        "Element",
+        "Bodies",
+        "K [N/mm]",
+        "a [mm]",
+        "α [rad (°)]",
+        "b [mm]",
+        "β [rad (°)]",
+        "m [kg]",
+        "r [mm]",
+        "φ [rad (°)]",
     ]);
     let recommended = r.recommended_ids();
-    for v in r.ranked() {
+    for v in variants {
         let Some(p) = &v.parameters else { continue };
         let mark = recommended.contains(&v.id);
         let mut first = true;
         let name = v.name.clone().unwrap_or_default();
+        let element = |label: &str| {
+            if v.idle.iter().any(|l| l == label) {
+                format!("{label} (idle)")
+            } else {
+                label.to_string()
+            }
+        };
         for s in &p.springs {
-            let (a, alpha) = vector_cells(s.anchor_a, s.plane);
-            let (b, beta) = vector_cells(s.anchor_b, s.plane);
+            let b = r.bounds_of(&s.label);
+            let (a, alpha) = vector_cells(s.anchor_a, s.plane, b.and_then(|b| b.anchor_a));
+            let (bb, beta) = vector_cells(s.anchor_b, s.plane, b.and_then(|b| b.anchor_b));
             t.push_marked(
                 vec![
                     Cell::text(if first { name.clone() } else { String::new() }),
-                    Cell::text(&s.label),
+                    Cell::text(element(&s.label)),
                     Cell::text(format!("{}–{}", s.body, s.other)),
-                    Cell::num(value(s.stiffness / 1000.0)),
+                    Cell::num(marked(
+                        value(s.stiffness / 1000.0),
+                        s.stiffness,
+                        b.and_then(|b| b.stiffness),
+                    )),
                     Cell::num(a),
                     Cell::num(alpha),
-                    Cell::num(b),
+                    Cell::num(bb),
                     Cell::num(beta),
                     Cell::empty(),
                     Cell::empty(),
@@ -335,18 +371,19 @@ pub fn parameters(r: &RunResults) -> Table {
             first = false;
         }
         for c in &p.counterweights {
-            let (rr, phi) = vector_cells(c.offset, c.plane);
+            let b = r.bounds_of(&c.label);
+            let (rr, phi) = vector_cells(c.offset, c.plane, b.and_then(|b| b.radius));
             t.push_marked(
                 vec![
                     Cell::text(if first { name.clone() } else { String::new() }),
-                    Cell::text(&c.label),
+                    Cell::text(element(&c.label)),
                     Cell::text(&c.body),
                     Cell::empty(),
                     Cell::empty(),
                     Cell::empty(),
                     Cell::empty(),
                     Cell::empty(),
-                    Cell::num(value(c.mass)),
+                    Cell::num(marked(value(c.mass), c.mass, b.and_then(|b| b.mass))),
                     Cell::num(rr),
                     Cell::num(phi),
                 ],
@@ -359,9 +396,33 @@ pub fn parameters(r: &RunResults) -> Table {
     t.without_empty_columns()
 }
 
+/// `text` with ` (min)` / ` (max)` when `x` is on an end of `range`.
+fn marked(text: String, x: f64, range: Option<[f64; 2]>) -> String {
+    match on_bound(x, range) {
+        Some(b) => format!("{text} ({})", b.word()),
+        None => text,
+    }
+}
+
+/// An angle in radians (Table 1 style) with its degrees: `π/2 (90°)`, `1.000 (57.3°)`.
+pub fn angle_with_degrees(rad: f64) -> String {
+    if !rad.is_finite() {
+        return angle(rad);
+    }
+    let deg = rad.rem_euclid(2.0 * std::f64::consts::PI).to_degrees();
+    let deg = if (deg - 360.0).abs() < 1e-4 { 0.0 } else { deg };
+    format!("{} ({}°)", angle(rad), fixed(deg, 1))
+}
+
 /// (length, angle) of a body-frame vector: polar in its plane when known (Table 1 style),
-/// else the Cartesian components in mm and no angle.
-fn vector_cells(v: [f64; 3], plane: Option<crate::results::Plane>) -> (String, String) {
+/// else the Cartesian components in mm and no angle. The length is marked when it is on an
+/// end of `range` (m).
+fn vector_cells(
+    v: [f64; 3],
+    plane: Option<crate::results::Plane>,
+    range: Option<[f64; 2]>,
+) -> (String, String) {
+    let length = v.iter().map(|x| x * x).sum::<f64>().sqrt();
     match plane {
         Some(p) => {
             let (r, phi) = polar(v, p.axes());
@@ -376,18 +437,97 @@ fn vector_cells(v: [f64; 3], plane: Option<crate::results::Plane>) -> (String, S
             } else {
                 fixed(r * 1000.0, 1)
             };
-            (len, if r > 1e-12 { angle(phi) } else { "–".into() })
+            (
+                marked(len, length, range),
+                if r > 1e-12 {
+                    angle_with_degrees(phi)
+                } else {
+                    "–".into()
+                },
+            )
         }
         None => (
-            format!(
-                "({}, {}, {})",
-                fixed(v[0] * 1000.0, 1),
-                fixed(v[1] * 1000.0, 1),
-                fixed(v[2] * 1000.0, 1)
+            marked(
+                format!(
+                    "({}, {}, {})",
+                    fixed(v[0] * 1000.0, 1),
+                    fixed(v[1] * 1000.0, 1),
+                    fixed(v[2] * 1000.0, 1)
+                ),
+                length,
+                range,
             ),
             String::new(),
         ),
     }
+}
+
+/// The variants the design views show: the recommended ones, then those drawn on request, in
+/// that order, each once.
+pub fn design_variants(r: &RunResults) -> Vec<&VariantRecord> {
+    let mut ids = r.recommended_ids();
+    for s in &r.schematics {
+        if !ids.contains(&s.variant) {
+            ids.push(s.variant);
+        }
+    }
+    ids.iter().filter_map(|&id| r.variant(id)).collect()
+}
+
+/// What to order for each spring of the recommended (and drawn) variants
+/// ([`crate::springspec`]): lengths in mm, forces in N.
+pub fn spring_specs(r: &RunResults) -> Table {
+    let mut t = Table::new(&[
+        "Variant",
+        "Spring",
+        "K [N/mm]",
+        "Length [mm]",
+        "Stroke [mm]",
+        "Force [N]",
+        "Energy [J]",
+        "Wire ≥ [kg]",
+        "Cable: pulley load [N]",
+        "Pre-tensioned: body [mm]",
+        "initial tension [N]",
+        "extension [mm]",
+    ]);
+    let recommended = r.recommended_ids();
+    for v in design_variants(r) {
+        for (k, s) in SpringSpec::of_variant(v).iter().enumerate() {
+            let mm = |x: f64| fixed(x * 1000.0, 0);
+            let (body, tension, ext) = match &s.pre_tensioned {
+                Some(p) => (
+                    mm(p.body_length),
+                    fixed(p.initial_tension, 0),
+                    format!("{}–{}", mm(p.extension[0]), mm(p.extension[1])),
+                ),
+                None => ("no room".into(), String::new(), String::new()),
+            };
+            t.push_marked(
+                vec![
+                    Cell::text(if k == 0 {
+                        v.display_name()
+                    } else {
+                        String::new()
+                    }),
+                    Cell::text(&s.label),
+                    Cell::num(value(s.stiffness / 1000.0)),
+                    Cell::num(format!("{}–{}", mm(s.length[0]), mm(s.length[1]))),
+                    Cell::num(mm(s.stroke)),
+                    Cell::num(format!("{}–{}", fixed(s.force[0], 0), fixed(s.force[1], 0))),
+                    Cell::num(fixed(s.energy, 0)),
+                    Cell::num(fixed(s.wire_mass, 1)),
+                    Cell::num(fixed(s.pulley_load, 0)),
+                    Cell::num(body),
+                    Cell::num(tension),
+                    Cell::num(ext),
+                ],
+                k == 0,
+                recommended.contains(&v.id),
+            );
+        }
+    }
+    t
 }
 
 /// Best variant of each class.
@@ -678,9 +818,9 @@ pub fn equivalent_group(r: &RunResults) -> Table {
         ];
         row.extend(practical_cells(v));
         row.push(Cell::text(if *id == rec.chosen {
-            "recommended"
+            "recommended".to_string()
         } else {
-            ""
+            v.idle_note().unwrap_or_default()
         }));
         t.push(row, false);
     }

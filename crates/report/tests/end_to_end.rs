@@ -503,7 +503,7 @@ fn writes_all_outputs_and_regenerates() {
     assert!(md.contains("| 457.2 | 38.5 | 2 |"), "{md}");
     assert!(md.contains("| 4535 |"), "{md}");
     assert!(
-        md.contains("| 998.9 | 0 |"),
+        md.contains("| 998.9 | 0 (0.0°) |"),
         "Table 1 anchor in mm and angle"
     );
 
@@ -784,7 +784,7 @@ fn charts_and_tables_follow_the_recommendation() {
     assert!(html.contains("the recommended variants (SB1, SB3, SB5)"));
     assert_eq!(
         html.matches("<tr class=\"rec\">").count() + html.matches("<tr class=\"g rec\">").count(),
-        3 + 3 + 6,
-        "ranking, practical figures, Table 1"
+        3 + 3 + 6 + counterpoise_report::tables::spring_specs(&r).rows.len(),
+        "ranking, practical figures, Table 1, the spring specifications (all recommended)"
     );
 }

@@ -1,0 +1,492 @@
+//! Schematics: a drawing of a variant — the mechanism's bodies and joints at one pose, each
+//! counterweight as a disc at its offset sized by its mass, each spring as a zig-zag between
+//! its anchors, labelled (the paper's Fig. 6, for any case).
+//!
+//! The geometry is world coordinates (m) computed from the model's kinematics by the caller
+//! (the `run` and `report` commands: this crate does not depend on the model), stored in
+//! results.json as [`Schematic`]s and drawn here. The drawing is an orthographic projection
+//! onto the plane spanned by the *up* direction (against gravity) and the horizontal direction
+//! along which the drawn points spread most (the principal axis of their horizontal
+//! components): a planar mechanism in a vertical plane is drawn in that plane, a spatial one
+//! (a base rotating about the vertical) in the vertical plane its arm is in.
+//!
+//! The SVG states its projection on its root element (`data-right`, `data-up`: unit world
+//! vectors; `data-scale`: px per m; `data-ox`, `data-oy`: the pixel of the world origin; and
+//! `data-q`: the configuration), so a point `p` is drawn at
+//! `x = ox + scale·(p·right)`, `y = oy − scale·(p·up)`; joints, counterweight centres and
+//! spring anchors are circles carrying `data-joint`, `data-cw` and `data-spring` +
+//! `data-end` (`a`, `b`). tests/report_schematic.rs reads them back and compares them with
+//! the model's kinematics.
+
+use std::fmt::Write;
+
+use serde::{Deserialize, Serialize};
+
+use crate::format::{escape_html as esc, fixed, mass, value};
+use crate::results::{RunResults, VariantRecord};
+
+/// The geometry of one drawing, world frame, m.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Schematic {
+    /// Variant id.
+    pub variant: usize,
+    /// The pose in words, e.g. `waypoint A of path cycle`.
+    pub pose: String,
+    /// The configuration drawn (the case's coordinates).
+    pub q: Vec<f64>,
+    /// Gravity, m/s² (its direction is down in the drawing).
+    pub gravity: [f64; 3],
+    pub bodies: Vec<DrawnBody>,
+    pub joints: Vec<DrawnJoint>,
+    pub counterweights: Vec<DrawnCounterweight>,
+    pub springs: Vec<DrawnSpring>,
+}
+
+/// A body: drawn as bars from its first point (where it hangs from its parent) to each other
+/// point (its other joints, its centre of mass).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DrawnBody {
+    pub name: String,
+    pub points: Vec<[f64; 3]>,
+    /// Centre of mass (where the label goes).
+    pub com: [f64; 3],
+}
+
+/// A joint centre.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DrawnJoint {
+    pub name: String,
+    pub at: [f64; 3],
+    /// One side is the base (drawn with a ground mark).
+    pub grounded: bool,
+}
+
+/// A counterweight: its centre of mass, and the point of its body it hangs from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DrawnCounterweight {
+    pub label: String,
+    pub at: [f64; 3],
+    pub from: [f64; 3],
+}
+
+/// A spring: its anchors, and the points of their bodies they are fixed to.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DrawnSpring {
+    pub label: String,
+    pub a: [f64; 3],
+    pub b: [f64; 3],
+    pub a_from: [f64; 3],
+    pub b_from: [f64; 3],
+}
+
+/// The projection of a drawing (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projection {
+    pub right: [f64; 3],
+    pub up: [f64; 3],
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+    let n = dot(v, v).sqrt();
+    (n > 1e-12 && n.is_finite()).then(|| [v[0] / n, v[1] / n, v[2] / n])
+}
+
+impl Schematic {
+    /// Every point drawn.
+    pub fn points(&self) -> Vec<[f64; 3]> {
+        let mut p: Vec<[f64; 3]> = Vec::new();
+        for b in &self.bodies {
+            p.extend(&b.points);
+            p.push(b.com);
+        }
+        p.extend(self.joints.iter().map(|j| j.at));
+        for c in &self.counterweights {
+            p.extend([c.at, c.from]);
+        }
+        for s in &self.springs {
+            p.extend([s.a, s.b, s.a_from, s.b_from]);
+        }
+        p
+    }
+
+    /// Up against gravity (world y when gravity is zero); right the principal horizontal
+    /// direction of the points, its largest component positive (deterministic sign).
+    pub fn projection(&self) -> Projection {
+        let up =
+            unit([-self.gravity[0], -self.gravity[1], -self.gravity[2]]).unwrap_or([0.0, 1.0, 0.0]);
+        let pts = self.points();
+        let n = pts.len().max(1) as f64;
+        let mean = pts.iter().fold([0.0; 3], |m, p| {
+            [m[0] + p[0] / n, m[1] + p[1] / n, m[2] + p[2] / n]
+        });
+        // Horizontal components, centred; covariance; power iteration from the horizontal
+        // axis of a fixed start (deterministic).
+        let horizontal = |v: [f64; 3]| {
+            let d = dot(v, up);
+            [v[0] - d * up[0], v[1] - d * up[1], v[2] - d * up[2]]
+        };
+        let mut cov = [[0.0; 3]; 3];
+        for p in &pts {
+            let h = horizontal([p[0] - mean[0], p[1] - mean[1], p[2] - mean[2]]);
+            for i in 0..3 {
+                for j in 0..3 {
+                    cov[i][j] += h[i] * h[j];
+                }
+            }
+        }
+        let fallback = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]
+            .into_iter()
+            .find_map(|a| unit(horizontal(a)))
+            .unwrap_or([1.0, 0.0, 0.0]);
+        let mut right = fallback;
+        for start in [[1.0, 0.3, 0.1], [0.1, 0.3, 1.0]] {
+            let mut v = match unit(horizontal(start)) {
+                Some(v) => v,
+                None => continue,
+            };
+            let mut ok = true;
+            for _ in 0..200 {
+                let w = [dot(cov[0], v), dot(cov[1], v), dot(cov[2], v)];
+                match unit(horizontal(w)) {
+                    Some(u) => v = u,
+                    None => {
+                        ok = false;
+                        break;
+                    }
+                }
+            }
+            if ok {
+                right = v;
+                break;
+            }
+        }
+        let k = (0..3)
+            .max_by(|&i, &j| right[i].abs().total_cmp(&right[j].abs()))
+            .unwrap_or(0);
+        if right[k] < 0.0 {
+            right = [-right[0], -right[1], -right[2]];
+        }
+        Projection { right, up }
+    }
+}
+
+/// Drawing size, px.
+const WIDTH: f64 = 560.0;
+const PLOT_HEIGHT: f64 = 380.0;
+const MARGIN: f64 = 46.0;
+const LINE: f64 = 15.0;
+
+/// Radius of a counterweight's disc, px: its volume (the cube of the radius) in proportion to
+/// its mass, 16 px for a tenth of the moving mass, at least 3 px so a light one stays visible.
+pub fn disc_radius(mass_kg: f64, moving_mass: Option<f64>) -> f64 {
+    let reference = moving_mass
+        .filter(|m| *m > 0.0)
+        .unwrap_or(10.0 * mass_kg.max(1e-9));
+    (16.0 * (mass_kg.max(0.0) / (0.1 * reference)).cbrt()).clamp(3.0, 30.0)
+}
+
+/// The zig-zag of a spring from `a` to `b` (px), with straight ends: `points` attribute text.
+fn zigzag(a: (f64, f64), b: (f64, f64)) -> String {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let len = dx.hypot(dy);
+    if len < 1e-9 {
+        return format!("{:.2},{:.2}", a.0, a.1);
+    }
+    let (ux, uy) = (dx / len, dy / len);
+    let (nx, ny) = (-uy, ux);
+    let end = (0.15 * len).min(12.0);
+    let zig = 10usize;
+    let amp = (0.08 * len).clamp(3.0, 7.0);
+    let mut pts = vec![a];
+    pts.push((a.0 + ux * end, a.1 + uy * end));
+    for k in 1..zig {
+        let t = end + (len - 2.0 * end) * k as f64 / zig as f64;
+        let side = if k % 2 == 1 { amp } else { -amp };
+        pts.push((a.0 + ux * t + nx * side, a.1 + uy * t + ny * side));
+    }
+    pts.push((b.0 - ux * end, b.1 - uy * end));
+    pts.push(b);
+    pts.iter()
+        .map(|(x, y)| format!("{x:.2},{y:.2}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The SVG of a schematic of variant `v` (its parameters label the elements).
+pub fn svg(r: &RunResults, v: &VariantRecord, s: &Schematic) -> String {
+    let proj = s.projection();
+    let pts = s.points();
+    let xy = |p: [f64; 3]| (dot(p, proj.right), dot(p, proj.up));
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for p in &pts {
+        let (x, y) = xy(*p);
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if !x0.is_finite() {
+        (x0, x1, y0, y1) = (-1.0, 1.0, -1.0, 1.0);
+    }
+    let span = (x1 - x0).max(y1 - y0).max(1e-6);
+    let scale = ((WIDTH - 2.0 * MARGIN) / (x1 - x0).max(span * 0.2))
+        .min((PLOT_HEIGHT - 2.0 * MARGIN) / (y1 - y0).max(span * 0.2));
+    let ox = WIDTH / 2.0 - scale * (x0 + x1) / 2.0;
+    let oy = PLOT_HEIGHT / 2.0 + scale * (y0 + y1) / 2.0;
+    let px = |p: [f64; 3]| {
+        let (x, y) = xy(p);
+        (ox + scale * x, oy - scale * y)
+    };
+    let params = v.parameters.clone().unwrap_or_default();
+    // The legend: one line per element, then the pose.
+    let mut legend: Vec<String> = Vec::new();
+    for c in &params.counterweights {
+        let r = dot(c.offset, c.offset).sqrt();
+        let idle = if v.idle.contains(&c.label) {
+            " (idle)"
+        } else {
+            ""
+        };
+        legend.push(format!(
+            "{}{idle}: {} at {} mm from the origin of {}",
+            c.label,
+            mass(c.mass),
+            fixed(r * 1000.0, 1),
+            c.body
+        ));
+    }
+    for sp in &params.springs {
+        let idle = if v.idle.contains(&sp.label) {
+            " (idle)"
+        } else {
+            ""
+        };
+        let n = |a: [f64; 3]| fixed(dot(a, a).sqrt() * 1000.0, 1);
+        legend.push(format!(
+            "{}{idle}: K = {} N/mm, a {} mm on {}, b {} mm on {}",
+            sp.label,
+            value(sp.stiffness / 1000.0),
+            n(sp.anchor_a),
+            sp.body,
+            n(sp.anchor_b),
+            sp.other
+        ));
+    }
+    legend.push(format!("Pose: {}", s.pose));
+    let height = PLOT_HEIGHT + 8.0 + LINE * legend.len() as f64;
+    let title = format!("{} at one pose", v.display_name());
+    let mut o = String::new();
+    let vec3 = |a: [f64; 3]| format!("{:.9} {:.9} {:.9}", a[0], a[1], a[2]);
+    let _ = write!(
+        o,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"chart schematic\" width=\"{WIDTH}\" height=\"{height:.0}\" viewBox=\"0 0 {WIDTH} {height:.0}\" role=\"img\" aria-label=\"{}\" data-variant=\"{}\" data-right=\"{}\" data-up=\"{}\" data-scale=\"{scale:.9}\" data-ox=\"{ox:.6}\" data-oy=\"{oy:.6}\" data-q=\"{}\">",
+        esc(&title),
+        v.id,
+        vec3(proj.right),
+        vec3(proj.up),
+        s.q.iter()
+            .map(|x| format!("{x:.12}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    let _ = write!(
+        o,
+        "<text x=\"10\" y=\"18\" font-size=\"13\" font-weight=\"600\" fill=\"#1d2327\">{}</text>",
+        esc(&title)
+    );
+    // Gravity arrow, top right.
+    let _ = write!(
+        o,
+        "<g stroke=\"#5f6b73\" fill=\"#5f6b73\"><line x1=\"{x:.1}\" y1=\"14\" x2=\"{x:.1}\" y2=\"40\" stroke-width=\"1.5\"/><path d=\"M{l:.1},36 L{x:.1},44 L{r:.1},36 Z\" stroke=\"none\"/></g><text x=\"{t:.1}\" y=\"32\" font-size=\"11\" fill=\"#5f6b73\">g</text>",
+        x = WIDTH - 20.0,
+        l = WIDTH - 24.0,
+        r = WIDTH - 16.0,
+        t = WIDTH - 34.0
+    );
+    // Bodies: bars from the first point to the others.
+    for b in &s.bodies {
+        let Some(&first) = b.points.first() else {
+            continue;
+        };
+        let (fx, fy) = px(first);
+        for &p in b.points.iter().skip(1).chain(std::iter::once(&b.com)) {
+            let (x, y) = px(p);
+            let _ = write!(
+                o,
+                "<line x1=\"{fx:.2}\" y1=\"{fy:.2}\" x2=\"{x:.2}\" y2=\"{y:.2}\" stroke=\"#9aa5ad\" stroke-width=\"7\" stroke-linecap=\"round\"/>"
+            );
+        }
+    }
+    for b in &s.bodies {
+        let (x, y) = px(b.com);
+        let _ = write!(
+            o,
+            "<circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"2.5\" fill=\"#5f6b73\" data-com=\"{}\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"10.5\" fill=\"#5f6b73\">{}</text>",
+            esc(&b.name),
+            x + 5.0,
+            y + 13.0,
+            esc(&b.name)
+        );
+    }
+    // Counterweights: an arm from their body, a disc sized by mass.
+    for c in &s.counterweights {
+        let m = params
+            .counterweights
+            .iter()
+            .find(|p| p.label == c.label)
+            .map_or(0.0, |p| p.mass);
+        let (fx, fy) = px(c.from);
+        let (x, y) = px(c.at);
+        let rr = disc_radius(m, r.moving_mass);
+        let idle = v.idle.contains(&c.label);
+        let _ = write!(
+            o,
+            "<line x1=\"{fx:.2}\" y1=\"{fy:.2}\" x2=\"{x:.2}\" y2=\"{y:.2}\" stroke=\"#0072B2\" stroke-width=\"2\"/><circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"{rr:.1}\" fill=\"{}\" fill-opacity=\"0.85\" stroke=\"#0072B2\" stroke-width=\"1.5\" data-cw=\"{}\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" font-weight=\"600\" fill=\"#0072B2\">{}{}</text>",
+            if idle { "#ffffff" } else { "#0072B2" },
+            esc(&c.label),
+            x + rr + 4.0,
+            y - 4.0,
+            esc(&c.label),
+            if idle { " (idle)" } else { "" }
+        );
+    }
+    // Springs: attachment lines, the zig-zag, the anchors.
+    for sp in &s.springs {
+        let (a, b) = (px(sp.a), px(sp.b));
+        for (from, to) in [(sp.a_from, a), (sp.b_from, b)] {
+            let f = px(from);
+            let _ = write!(
+                o,
+                "<line x1=\"{:.2}\" y1=\"{:.2}\" x2=\"{:.2}\" y2=\"{:.2}\" stroke=\"#009E73\" stroke-width=\"1.2\" stroke-dasharray=\"4 3\"/>",
+                f.0, f.1, to.0, to.1
+            );
+        }
+        let _ = write!(
+            o,
+            "<polyline points=\"{}\" fill=\"none\" stroke=\"#009E73\" stroke-width=\"1.8\" stroke-linejoin=\"round\" data-spring-line=\"{}\"/>",
+            zigzag(a, b),
+            esc(&sp.label)
+        );
+        for (end, (x, y)) in [("a", a), ("b", b)] {
+            let _ = write!(
+                o,
+                "<circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"3.5\" fill=\"#ffffff\" stroke=\"#009E73\" stroke-width=\"1.8\" data-spring=\"{}\" data-end=\"{end}\"/>",
+                esc(&sp.label)
+            );
+        }
+        let mid = ((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
+        let _ = write!(
+            o,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" font-weight=\"600\" fill=\"#009E73\">{}{}</text>",
+            mid.0 + 8.0,
+            mid.1 - 6.0,
+            esc(&sp.label),
+            if v.idle.contains(&sp.label) {
+                " (idle)"
+            } else {
+                ""
+            }
+        );
+    }
+    // Joints on top.
+    for j in &s.joints {
+        let (x, y) = px(j.at);
+        if j.grounded {
+            let _ = write!(
+                o,
+                "<path d=\"M{:.1},{:.1} L{:.1},{:.1} M{:.1},{:.1} l-5,6 M{:.1},{:.1} l-5,6 M{:.1},{:.1} l-5,6\" stroke=\"#1d2327\" stroke-width=\"1.2\" fill=\"none\"/>",
+                x - 10.0,
+                y + 8.0,
+                x + 10.0,
+                y + 8.0,
+                x - 5.0,
+                y + 8.0,
+                x + 1.0,
+                y + 8.0,
+                x + 7.0,
+                y + 8.0
+            );
+        }
+        let _ = write!(
+            o,
+            "<circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"4.5\" fill=\"#ffffff\" stroke=\"#1d2327\" stroke-width=\"1.8\" data-joint=\"{}\"><title>{}</title></circle>",
+            esc(&j.name),
+            esc(&j.name)
+        );
+    }
+    // Scale bar: a round length near a fifth of the width.
+    let target = (WIDTH / 5.0) / scale;
+    let mag = 10f64.powf(target.log10().floor());
+    let bar = [1.0, 2.0, 5.0]
+        .iter()
+        .map(|k| k * mag)
+        .rfind(|l| *l <= target)
+        .unwrap_or(mag);
+    let _ = write!(
+        o,
+        "<g stroke=\"#5f6b73\"><line x1=\"12\" y1=\"{y:.1}\" x2=\"{x2:.1}\" y2=\"{y:.1}\" stroke-width=\"2\"/></g><text x=\"12\" y=\"{ty:.1}\" font-size=\"11\" fill=\"#5f6b73\">{} mm</text>",
+        fixed(bar * 1000.0, 0),
+        y = PLOT_HEIGHT - 12.0,
+        x2 = 12.0 + bar * scale,
+        ty = PLOT_HEIGHT - 18.0
+    );
+    for (k, line) in legend.iter().enumerate() {
+        let _ = write!(
+            o,
+            "<text x=\"12\" y=\"{:.1}\" font-size=\"11.5\" fill=\"#1d2327\">{}</text>",
+            PLOT_HEIGHT + 6.0 + LINE * (k as f64 + 0.7),
+            esc(line)
+        );
+    }
+    o.push_str("</svg>");
+    o
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Schematic {
+        Schematic {
+            variant: 0,
+            pose: "test".into(),
+            q: vec![0.0],
+            gravity: [0.0, 0.0, -9.81],
+            bodies: vec![DrawnBody {
+                name: "arm".into(),
+                points: vec![[0.0, 0.0, 0.0], [1.0, 1.0, 0.5]],
+                com: [0.5, 0.5, 0.25],
+            }],
+            joints: vec![],
+            counterweights: vec![],
+            springs: vec![],
+        }
+    }
+
+    #[test]
+    fn projection_is_up_and_the_horizontal_spread() {
+        // Gravity along −z: up = +z. The points spread horizontally along (1, 1, 0)/√2.
+        let p = sample().projection();
+        assert_eq!(p.up, [0.0, 0.0, 1.0]);
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        assert!((p.right[0] - h).abs() < 1e-9 && (p.right[1] - h).abs() < 1e-9);
+        assert!(p.right[2].abs() < 1e-12);
+    }
+
+    #[test]
+    fn discs_by_volume() {
+        // A tenth of the moving mass: 16 px; 1/8 of that mass: half the radius.
+        assert!((disc_radius(10.0, Some(100.0)) - 16.0).abs() < 1e-12);
+        assert!((disc_radius(1.25, Some(100.0)) - 8.0).abs() < 1e-12);
+        assert_eq!(disc_radius(1e-6, Some(100.0)), 3.0);
+    }
+}

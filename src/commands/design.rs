@@ -1,0 +1,223 @@
+//! What the report shows of a design beyond its numbers, computed from the model: the bounds
+//! each element was optimised within (to mark parameters on a bound) and the schematics
+//! (world coordinates of bodies, joints, counterweights and spring anchors at one pose). Called at the end of
+//! `run` and `merge` and by `report DIR`, which rebuilds the model from the case echo in
+//! results.json, so reports of older results gain them too.
+
+use anyhow::Result;
+use counterpoise_balance::{Catalogue, catalogue_options, mechanism_energy};
+use counterpoise_model::{BodyId, Kinematics, Model};
+use counterpoise_optimise::{BoundsTable, ElementBounds as OptBounds};
+use counterpoise_report as report;
+use nalgebra::{DVector, Vector3};
+
+/// The bounds of every catalogue element of `model`, by label.
+pub fn element_bounds(model: &Model) -> Result<Vec<report::ElementBounds>> {
+    let catalogue = Catalogue::build(&mechanism_energy(model), &catalogue_options(model));
+    let table = BoundsTable::new(model, &catalogue)?;
+    Ok(catalogue
+        .entries
+        .iter()
+        .zip(&table.entries)
+        .map(|(e, b)| match b {
+            OptBounds::Counterweight(c) => report::ElementBounds {
+                label: e.label.clone(),
+                mass: Some(c.mass),
+                radius: Some(c.radius),
+                stiffness: None,
+                anchor_a: None,
+                anchor_b: None,
+            },
+            OptBounds::Spring(s) => report::ElementBounds {
+                label: e.label.clone(),
+                mass: None,
+                radius: None,
+                stiffness: Some(s.stiffness),
+                anchor_a: Some(s.anchor_a),
+                anchor_b: Some(s.anchor_b),
+            },
+        })
+        .collect())
+}
+
+/// The pose the schematics are drawn at, in words, and its configuration: the first waypoint
+/// of the case's first path (the start of the cycle the report simulates), else the middle
+/// point of the task grid, else the coordinates' range midpoints (the model's reference
+/// configuration). A waypoint or grid point whose configuration cannot be solved falls back to
+/// the next choice.
+pub fn reference_pose(model: &Model) -> (String, Vec<f64>) {
+    let solver = counterpoise_dynamics::Evaluator::new(model).ok();
+    let solve = |u: &[f64]| solver.as_ref().and_then(|e| e.solve_point(u).ok());
+    if let Some(path) = model.paths.first()
+        && let Some(&first) = path.sequence.first()
+        && let Some(w) = path.waypoints.get(first)
+        && let Some(q) = solve(&w.u)
+    {
+        return (
+            format!(
+                "waypoint {} of path {} (where its cycle starts)",
+                w.name, path.name
+            ),
+            q,
+        );
+    }
+    if let Some(tasks) = &model.tasks {
+        let points = tasks.grid_points();
+        let k = points.len() / 2;
+        if let Some(q) = points.get(k).and_then(|u| solve(u)) {
+            return (format!("task-grid point {k} (the middle of the grid)"), q);
+        }
+    }
+    (
+        "the middle of every coordinate's range".into(),
+        model.reference_configuration(),
+    )
+}
+
+/// World position of `p` (body frame of `body`, or the base frame) at `q`.
+fn world(
+    model: &Model,
+    kin: &Kinematics,
+    body: Option<usize>,
+    p: Vector3<f64>,
+    q: &DVector<f64>,
+) -> [f64; 3] {
+    let w = match body {
+        Some(b) if b < model.bodies.len() => {
+            let pose = kin.body_pose(b, q);
+            pose.position + pose.rotation * p
+        }
+        _ => p,
+    };
+    [w.x, w.y, w.z]
+}
+
+/// The schematic of variant `v` (its optimised parameters) at configuration `q`.
+pub fn schematic(
+    model: &Model,
+    kin: &Kinematics,
+    v: &report::VariantRecord,
+    (pose, q): (&str, &[f64]),
+) -> report::Schematic {
+    let qv = DVector::from_column_slice(q);
+    let body_index = |name: &str| model.body_index(name);
+    // Each body's points: where it hangs from (joints where it is the second body first),
+    // then its other joints.
+    let mut points: Vec<Vec<[f64; 3]>> = vec![Vec::new(); model.bodies.len()];
+    for second in [true, false] {
+        for j in &model.joints {
+            for (k, id) in j.bodies.iter().enumerate() {
+                if (k == 1) != second {
+                    continue;
+                }
+                if let BodyId::Body(b) = id {
+                    points[*b].push(world(model, kin, Some(*b), j.points[k], &qv));
+                }
+            }
+        }
+    }
+    let bodies: Vec<report::DrawnBody> = model
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(b, body)| {
+            let mut pts = points[b].clone();
+            if pts.is_empty() {
+                pts.push(world(model, kin, Some(b), Vector3::zeros(), &qv));
+            }
+            report::DrawnBody {
+                name: body.name.clone(),
+                points: pts,
+                com: world(model, kin, Some(b), body.com, &qv),
+            }
+        })
+        .collect();
+    let hang = |b: Option<usize>, fallback: [f64; 3]| {
+        b.and_then(|b| bodies.get(b))
+            .and_then(|d| d.points.first().copied())
+            .unwrap_or(fallback)
+    };
+    let joints = model
+        .joints
+        .iter()
+        .map(|j| report::DrawnJoint {
+            name: j.name.clone(),
+            at: world(model, kin, j.bodies[0].index(), j.points[0], &qv),
+            grounded: j.bodies.contains(&BodyId::Base),
+        })
+        .collect();
+    let params = v.parameters.clone().unwrap_or_default();
+    let counterweights = params
+        .counterweights
+        .iter()
+        .map(|c| {
+            let b = body_index(&c.body);
+            let at = world(model, kin, b, Vector3::from(c.offset), &qv);
+            report::DrawnCounterweight {
+                label: c.label.clone(),
+                at,
+                from: hang(b, at),
+            }
+        })
+        .collect();
+    let springs = params
+        .springs
+        .iter()
+        .map(|s| {
+            let (ba, bb) = (body_index(&s.body), body_index(&s.other));
+            let a = world(model, kin, ba, Vector3::from(s.anchor_a), &qv);
+            let b = world(model, kin, bb, Vector3::from(s.anchor_b), &qv);
+            report::DrawnSpring {
+                label: s.label.clone(),
+                a,
+                b,
+                a_from: hang(ba, a),
+                b_from: hang(bb, b),
+            }
+        })
+        .collect();
+    report::Schematic {
+        variant: v.id,
+        pose: pose.to_string(),
+        q: q.to_vec(),
+        gravity: [model.gravity.x, model.gravity.y, model.gravity.z],
+        bodies,
+        joints,
+        counterweights,
+        springs,
+    }
+}
+
+/// Schematics of the recommended variants (after the decision), then of `extra` (variant
+/// names such as `SB12`, or labels such as `m4 + K43`), each once.
+pub fn schematics(
+    model: &Model,
+    results: &report::RunResults,
+    extra: &[String],
+) -> Result<Vec<report::Schematic>> {
+    let kin = Kinematics::new(model);
+    let (pose, q) = reference_pose(model);
+    let mut ids = results.recommended_ids();
+    for name in extra {
+        let found = results
+            .ranked()
+            .into_iter()
+            .find(|v| v.name.as_deref() == Some(name.as_str()) || v.label() == *name);
+        match found {
+            Some(v) => {
+                if !ids.contains(&v.id) {
+                    ids.push(v.id);
+                }
+            }
+            None => anyhow::bail!(
+                "--draw {name}: no ranked variant of that name (SB1…SB{}) or elements",
+                results.ranked().len()
+            ),
+        }
+    }
+    Ok(ids
+        .iter()
+        .filter_map(|&id| results.variant(id))
+        .map(|v| schematic(model, &kin, v, (&pose, &q)))
+        .collect())
+}

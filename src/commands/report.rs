@@ -1,0 +1,59 @@
+//! `counterpoise report DIR`: rewrites the reports from `DIR/results.json`. The model is
+//! rebuilt from the case echo in the results, so what the reports compute from it (the
+//! bounds of each element) is there for results written by earlier versions too; a case echo
+//! that no longer validates leaves those parts out, with a note on stderr.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use anyhow::Result;
+use counterpoise::preflight;
+use counterpoise_model::{Case, Model};
+use counterpoise_report as report;
+
+/// Rewrites the reports, with the decision recomputed (at `tolerance` when one is given, else
+/// at the tolerance the results were decided at: the idle elements are marked anew, and the
+/// recommendation never holds one).
+pub fn run(dir: &Path, tolerance: Option<f64>, draw: &[String]) -> Result<ExitCode> {
+    let mut results = report::read_results(dir)?;
+    let model = model_of(&results);
+    if let Some(model) = &model
+        && results.element_bounds.is_empty()
+    {
+        results.element_bounds = super::design::element_bounds(model)?;
+    }
+    let tolerance = tolerance
+        .or_else(|| results.decision.as_ref().map(|d| d.tolerance))
+        .unwrap_or(report::decision::DEFAULT_TOLERANCE);
+    results.redecide(tolerance);
+    match &model {
+        Some(model) => results.schematics = super::design::schematics(model, &results, draw)?,
+        None if !draw.is_empty() => {
+            anyhow::bail!(
+                "--draw needs the model, and the case echo in results.json does not validate"
+            )
+        }
+        None => {}
+    }
+    let written = report::write_reports(dir, &results)?;
+    for f in written {
+        println!("wrote {}", f.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The model of the case echo, or `None` (said on stderr) when it does not validate.
+pub fn model_of(results: &report::RunResults) -> Option<Model> {
+    let text = serde_json::to_string(&results.case).ok()?;
+    match Case::from_json_str_with(&text, preflight::limits()) {
+        Ok(model) => Some(model),
+        Err(errors) => {
+            eprintln!(
+                "note: the case echo in results.json does not validate ({} error(s)); the \
+                 reports leave out what needs the model",
+                errors.len()
+            );
+            None
+        }
+    }
+}
