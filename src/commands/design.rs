@@ -92,11 +92,12 @@ fn world(
     [w.x, w.y, w.z]
 }
 
-/// The schematic of variant `v` (its optimised parameters) at configuration `q`.
+/// The schematic of variant `v` (its optimised parameters; `None`: the unbalanced mechanism)
+/// at configuration `q`.
 pub fn schematic(
     model: &Model,
     kin: &Kinematics,
-    v: &report::VariantRecord,
+    v: Option<&report::VariantRecord>,
     (pose, q): (&str, &[f64]),
 ) -> report::Schematic {
     let qv = DVector::from_column_slice(q);
@@ -146,7 +147,7 @@ pub fn schematic(
             grounded: j.bodies.contains(&BodyId::Base),
         })
         .collect();
-    let params = v.parameters.clone().unwrap_or_default();
+    let params = v.and_then(|v| v.parameters.clone()).unwrap_or_default();
     let counterweights = params
         .counterweights
         .iter()
@@ -177,7 +178,7 @@ pub fn schematic(
         })
         .collect();
     report::Schematic {
-        variant: v.id,
+        variant: v.map(|v| v.id),
         pose: pose.to_string(),
         q: q.to_vec(),
         gravity: [model.gravity.x, model.gravity.y, model.gravity.z],
@@ -189,7 +190,8 @@ pub fn schematic(
 }
 
 /// Schematics of the recommended variants (after the decision), then of `extra` (variant
-/// names such as `SB12`, or labels such as `m4 + K43`), each once.
+/// names such as `SB12`, or labels such as `m4 + K43`), each once; the unbalanced mechanism
+/// when there is none of either (so every report shows what the mechanism looks like).
 pub fn schematics(
     model: &Model,
     results: &report::RunResults,
@@ -215,9 +217,12 @@ pub fn schematics(
             ),
         }
     }
+    if ids.is_empty() {
+        return Ok(vec![schematic(model, &kin, None, (&pose, &q))]);
+    }
     Ok(ids
         .iter()
         .filter_map(|&id| results.variant(id))
-        .map(|v| schematic(model, &kin, v, (&pose, &q)))
+        .map(|v| schematic(model, &kin, Some(v), (&pose, &q)))
         .collect())
 }

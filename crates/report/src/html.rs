@@ -73,6 +73,10 @@ pub fn render(r: &RunResults) -> String {
     }
 
     push_decision(&mut h, r, &charts);
+    if tables::recommendations(r).rows.is_empty() && !r.schematics.is_empty() {
+        h.push_str("<h2>The mechanism</h2><p class=\"note\">No variant to recommend; the mechanism as the case describes it.</p>");
+        push_schematics(&mut h, r, "");
+    }
 
     h.push_str("<h2>Summary</h2>");
     let best = tables::best_per_class(r);
@@ -234,7 +238,7 @@ fn push_decision(h: &mut String, r: &RunResults, charts: &[Chart]) {
         let _ = write!(h, "<li><b>{}.</b> {}</li>", esc(&scope), esc(&reason));
     }
     h.push_str("</ul>");
-    push_schematics(h, r);
+    push_schematics(h, r, "What they look like");
     let specs = tables::spring_specs(r);
     if !specs.rows.is_empty() {
         h.push_str("<h3>Spring specifications</h3>");
@@ -266,17 +270,19 @@ fn push_decision(h: &mut String, r: &RunResults, charts: &[Chart]) {
 }
 
 /// The drawings of the recommended variants (and of those `report --draw` named).
-fn push_schematics(h: &mut String, r: &RunResults) {
-    let drawn: Vec<_> = r
-        .schematics
-        .iter()
-        .filter_map(|s| r.variant(s.variant).map(|v| (v, s)))
-        .collect();
-    if drawn.is_empty() {
+fn push_schematics(h: &mut String, r: &RunResults, heading: &str) {
+    if r.schematics.is_empty() {
         return;
     }
-    h.push_str("<h3>What they look like</h3><div class=\"charts\">");
-    for (v, s) in drawn {
+    if !heading.is_empty() {
+        let _ = write!(h, "<h3>{}</h3>", esc(heading));
+    }
+    h.push_str("<div class=\"charts\">");
+    for s in &r.schematics {
+        let v = s.variant.and_then(|id| r.variant(id));
+        if s.variant.is_some() && v.is_none() {
+            continue;
+        }
         let _ = write!(h, "<figure>{}</figure>", crate::schematic::svg(r, v, s));
     }
     h.push_str("</div><p class=\"note\">Bodies (grey bars from the joint each hangs from to its other joints and its centre of mass, a dot), joints (open circles, hatched where on the base), counterweights (blue discs at their centre of mass, area growing with the mass: the volume of a disc of the same material), springs (green zig-zags between their anchors, dashed to the joint of the body each anchor is on). Drawn from the model's kinematics, orthographic, in the vertical plane the mechanism spreads in most; up is against gravity.</p>");

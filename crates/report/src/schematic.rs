@@ -28,8 +28,9 @@ use crate::results::{RunResults, VariantRecord};
 /// The geometry of one drawing, world frame, m.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Schematic {
-    /// Variant id.
-    pub variant: usize,
+    /// Variant id; `None` for the unbalanced mechanism (drawn when no variant is recommended).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant: Option<usize>,
     /// The pose in words, e.g. `waypoint A of path cycle`.
     pub pose: String,
     /// The configuration drawn (the case's coordinates).
@@ -216,8 +217,10 @@ fn zigzag(a: (f64, f64), b: (f64, f64)) -> String {
         .join(" ")
 }
 
-/// The SVG of a schematic of variant `v` (its parameters label the elements).
-pub fn svg(r: &RunResults, v: &VariantRecord, s: &Schematic) -> String {
+/// The SVG of a schematic of variant `v` (its parameters label the elements), or of the
+/// unbalanced mechanism.
+pub fn svg(r: &RunResults, v: Option<&VariantRecord>, s: &Schematic) -> String {
+    let idle: Vec<String> = v.map(|v| v.idle.clone()).unwrap_or_default();
     let proj = s.projection();
     let pts = s.points();
     let xy = |p: [f64; 3]| (dot(p, proj.right), dot(p, proj.up));
@@ -246,12 +249,12 @@ pub fn svg(r: &RunResults, v: &VariantRecord, s: &Schematic) -> String {
         let (x, y) = xy(p);
         (ox + scale * x, oy - scale * y)
     };
-    let params = v.parameters.clone().unwrap_or_default();
+    let params = v.and_then(|v| v.parameters.clone()).unwrap_or_default();
     // The legend: one line per element, then the pose.
     let mut legend: Vec<String> = Vec::new();
     for c in &params.counterweights {
         let r = dot(c.offset, c.offset).sqrt();
-        let idle = if v.idle.contains(&c.label) {
+        let idle = if idle.contains(&c.label) {
             " (idle)"
         } else {
             ""
@@ -265,7 +268,7 @@ pub fn svg(r: &RunResults, v: &VariantRecord, s: &Schematic) -> String {
         ));
     }
     for sp in &params.springs {
-        let idle = if v.idle.contains(&sp.label) {
+        let idle = if idle.contains(&sp.label) {
             " (idle)"
         } else {
             ""
@@ -283,14 +286,17 @@ pub fn svg(r: &RunResults, v: &VariantRecord, s: &Schematic) -> String {
     }
     legend.push(format!("Pose: {}", s.pose));
     let height = PLOT_HEIGHT + 8.0 + LINE * legend.len() as f64;
-    let title = format!("{} at one pose", v.display_name());
+    let title = match v {
+        Some(v) => format!("{} at one pose", v.display_name()),
+        None => "The unbalanced mechanism at one pose".to_string(),
+    };
     let mut o = String::new();
     let vec3 = |a: [f64; 3]| format!("{:.9} {:.9} {:.9}", a[0], a[1], a[2]);
     let _ = write!(
         o,
         "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"chart schematic\" width=\"{WIDTH}\" height=\"{height:.0}\" viewBox=\"0 0 {WIDTH} {height:.0}\" role=\"img\" aria-label=\"{}\" data-variant=\"{}\" data-right=\"{}\" data-up=\"{}\" data-scale=\"{scale:.9}\" data-ox=\"{ox:.6}\" data-oy=\"{oy:.6}\" data-q=\"{}\">",
         esc(&title),
-        v.id,
+        v.map_or("UB".to_string(), |v| v.id.to_string()),
         vec3(proj.right),
         vec3(proj.up),
         s.q.iter()
@@ -347,7 +353,7 @@ pub fn svg(r: &RunResults, v: &VariantRecord, s: &Schematic) -> String {
         let (fx, fy) = px(c.from);
         let (x, y) = px(c.at);
         let rr = disc_radius(m, r.moving_mass);
-        let idle = v.idle.contains(&c.label);
+        let idle = idle.contains(&c.label);
         let _ = write!(
             o,
             "<line x1=\"{fx:.2}\" y1=\"{fy:.2}\" x2=\"{x:.2}\" y2=\"{y:.2}\" stroke=\"#0072B2\" stroke-width=\"2\"/><circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"{rr:.1}\" fill=\"{}\" fill-opacity=\"0.85\" stroke=\"#0072B2\" stroke-width=\"1.5\" data-cw=\"{}\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" font-weight=\"600\" fill=\"#0072B2\">{}{}</text>",
@@ -390,7 +396,7 @@ pub fn svg(r: &RunResults, v: &VariantRecord, s: &Schematic) -> String {
             mid.0 + 8.0,
             mid.1 - 6.0,
             esc(&sp.label),
-            if v.idle.contains(&sp.label) {
+            if idle.contains(&sp.label) {
                 " (idle)"
             } else {
                 ""
@@ -457,7 +463,7 @@ mod tests {
 
     fn sample() -> Schematic {
         Schematic {
-            variant: 0,
+            variant: Some(0),
             pose: "test".into(),
             q: vec![0.0],
             gravity: [0.0, 0.0, -9.81],

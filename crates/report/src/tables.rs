@@ -466,9 +466,9 @@ fn vector_cells(
 /// that order, each once.
 pub fn design_variants(r: &RunResults) -> Vec<&VariantRecord> {
     let mut ids = r.recommended_ids();
-    for s in &r.schematics {
-        if !ids.contains(&s.variant) {
-            ids.push(s.variant);
+    for id in r.schematics.iter().filter_map(|s| s.variant) {
+        if !ids.contains(&id) {
+            ids.push(id);
         }
     }
     ids.iter().filter_map(|&id| r.variant(id)).collect()
