@@ -6,7 +6,8 @@
 
 use anyhow::Result;
 use counterpoise_balance::{Catalogue, catalogue_options, mechanism_energy};
-use counterpoise_model::{BodyId, Kinematics, Model};
+use counterpoise_dynamics::{ParameterSet, Variant};
+use counterpoise_model::{BodyId, Kinematics, Model, PayloadMode};
 use counterpoise_optimise::{BoundsTable, ElementBounds as OptBounds};
 use counterpoise_report as report;
 use nalgebra::{DVector, Vector3};
@@ -225,4 +226,97 @@ pub fn schematics(
         .filter_map(|&id| results.variant(id))
         .map(|v| schematic(model, &kin, Some(v), (&pose, &q)))
         .collect())
+}
+
+/// Samples per path segment of the energy chart (as the path simulation samples it).
+const ENERGY_SAMPLES_PER_SEGMENT: usize = 60;
+
+/// Potential energy of the unbalanced mechanism (bodies and the payloads the balancing counts)
+/// and of the recommended and drawn variants (plus their counterweights' weight and their
+/// springs' `½·K·L²`), along the case's first path, or, without one, along the unbalanced
+/// robot's QTR task; each relative to its first sample.
+pub fn energy_chart(
+    model: &Model,
+    results: &report::RunResults,
+) -> Result<Option<report::EnergyChart>> {
+    let variants = report::tables::design_variants(results);
+    if variants.is_empty() {
+        return Ok(None);
+    }
+    let params = ParameterSet::from_variants(model, &[Variant::default()])?;
+    let (along, t, qs) = if model.paths.is_empty() {
+        let task = results.unbalanced.qtr_task;
+        let s = counterpoise_dynamics::task_series_with(model, &params, 0, task[0], task[1], None)?;
+        (
+            format!(
+                "task {}→{} (the unbalanced robot's QTR task)",
+                task[0], task[1]
+            ),
+            s.t,
+            s.q,
+        )
+    } else {
+        let s =
+            counterpoise_dynamics::path_series(model, &params, 0, 0, ENERGY_SAMPLES_PER_SEGMENT)?;
+        (format!("path {}", model.paths[0].name), s.t, s.q)
+    };
+    let kin = Kinematics::new(model);
+    let unbalanced = model.potential_energy(PayloadMode::InBalance);
+    let g = model.gravity;
+    let ub: Vec<f64> = qs
+        .iter()
+        .map(|q| unbalanced.eval(&model.point(q)))
+        .collect();
+    let relative = |v: Vec<f64>| -> Vec<f64> {
+        let v0 = v.first().copied().unwrap_or(0.0);
+        v.into_iter().map(|x| x - v0).collect()
+    };
+    let mut curves = vec![report::Curve {
+        label: "UB".into(),
+        variant: None,
+        values: relative(ub.clone()),
+    }];
+    for v in variants {
+        let Some(p) = &v.parameters else { continue };
+        let values: Vec<f64> = qs
+            .iter()
+            .zip(&ub)
+            .map(|(q, v_ub)| {
+                let qv = DVector::from_column_slice(q);
+                let at = |body: &str, r: [f64; 3]| -> Vector3<f64> {
+                    let w = world(model, &kin, model.body_index(body), Vector3::from(r), &qv);
+                    Vector3::from(w)
+                };
+                let mut e = *v_ub;
+                for c in &p.counterweights {
+                    e -= c.mass * g.dot(&at(&c.body, c.offset));
+                }
+                for s in &p.springs {
+                    let d = at(&s.body, s.anchor_a) - at(&s.other, s.anchor_b);
+                    e += 0.5 * s.stiffness * d.norm_squared();
+                }
+                e
+            })
+            .collect();
+        curves.push(report::Curve {
+            label: results.shown_label(v),
+            variant: Some(v.id),
+            values: relative(values),
+        });
+    }
+    let picked = model
+        .paths
+        .first()
+        .and_then(|p| p.payload.as_ref())
+        .map(|_| " The path's payload, picked and dropped on the way, is not counted: the balancing does not see it.")
+        .unwrap_or("");
+    Ok(Some(report::EnergyChart {
+        along,
+        note: Some(format!(
+            "Gravity energy of the bodies and of the payloads the balancing counts, plus the \
+             counterweights' and the springs' (½·K·L²), relative to the first sample.{picked}"
+        )),
+        t,
+        curves,
+    }))
 }

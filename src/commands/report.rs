@@ -27,7 +27,10 @@ pub fn run(dir: &Path, tolerance: Option<f64>, draw: &[String]) -> Result<ExitCo
         .unwrap_or(report::decision::DEFAULT_TOLERANCE);
     results.redecide(tolerance);
     match &model {
-        Some(model) => results.schematics = super::design::schematics(model, &results, draw)?,
+        Some(model) => {
+            results.schematics = super::design::schematics(model, &results, draw)?;
+            results.energy = super::design::energy_chart(model, &results)?;
+        }
         None if !draw.is_empty() => {
             anyhow::bail!(
                 "--draw needs the model, and the case echo in results.json does not validate"

@@ -441,6 +441,7 @@ pub fn finish(
         }
         results.finalize(&study.ranking)?;
         results.schematics = super::design::schematics(model, &results, &[])?;
+        results.energy = super::design::energy_chart(model, &results)?;
         Ok(())
     })?;
     results.metadata.timings = timer.timings;

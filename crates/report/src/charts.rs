@@ -20,6 +20,8 @@ pub struct Chart {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Section {
     Decision,
+    /// The potential energy along a motion (after the schematics).
+    Energy,
     Ranking,
     Torque,
     PathStatic,
@@ -57,6 +59,7 @@ pub const MIN_BARS: usize = 3;
 /// Every chart of the report, in display order.
 pub fn all(r: &RunResults) -> Vec<Chart> {
     let mut charts: Vec<Chart> = pareto(r).into_iter().collect();
+    charts.extend(energy(r));
     charts.extend(ranking_bars(r));
     charts.extend(torque(r));
     if let Some(p) = &r.path {
@@ -361,6 +364,45 @@ fn scale<'a>(values: impl Iterator<Item = &'a f64>) -> f64 {
     values
         .filter(|v| v.is_finite())
         .fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
+/// Potential energy of UB and the recommended variants along one motion: the proof a reader
+/// sees (a balanced variant's line is flat).
+fn energy(r: &RunResults) -> Option<Chart> {
+    let e = r.energy.as_ref()?;
+    let title = format!("Potential energy along {}", e.along);
+    let chart = LineChart {
+        title: title.clone(),
+        subtitle: Some("relative to the start; flat = statically balanced".into()),
+        x_label: "time [s]".into(),
+        y_label: "potential energy [J]".into(),
+        y_unit: "J".into(),
+        series: e
+            .curves
+            .iter()
+            .enumerate()
+            .map(|(k, curve)| {
+                let (color, dash, marker) = curve_style(r, k, curve.variant);
+                LineSeries {
+                    label: curve.label.clone(),
+                    color,
+                    dash,
+                    marker,
+                    x: e.t.clone(),
+                    y: curve.values.clone(),
+                }
+            })
+            .collect(),
+        include_zero: true,
+        noise_scale: None,
+        width: 560.0,
+        height: 330.0,
+    };
+    Some(Chart {
+        section: Section::Energy,
+        title,
+        svg: line_chart(&chart),
+    })
 }
 
 /// Motor torque of UB and the best variants on the critical tasks.

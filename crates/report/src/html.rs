@@ -239,6 +239,15 @@ fn push_decision(h: &mut String, r: &RunResults, charts: &[Chart]) {
     }
     h.push_str("</ul>");
     push_schematics(h, r, "What they look like");
+    if let Some(e) = &r.energy {
+        h.push_str("<h3>The proof: potential energy</h3>");
+        push_charts(h, charts, Section::Energy);
+        let _ = write!(
+            h,
+            "<p class=\"note\">{} A statically balanced variant keeps its potential energy constant in every pose, so its line is flat; the unbalanced mechanism's energy changes by what its motors must supply against gravity. The motor torques of the same variants follow below (critical tasks, and the path simulation).</p>",
+            esc(e.note.as_deref().unwrap_or(""))
+        );
+    }
     let specs = tables::spring_specs(r);
     if !specs.rows.is_empty() {
         h.push_str("<h3>Spring specifications</h3>");

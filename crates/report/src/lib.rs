@@ -82,9 +82,9 @@ pub use practical::{PracticalFigures, SpringPeak};
 pub use ranking::{Class, RankItem, Ranking, RankingError, RankingOptions, rank};
 pub use results::{
     ActuatorSummary, CounterweightParams, CriticalTask, Curve, ElementInfo, ElementKind,
-    Evaluation, FreeDirection, JointPeak, OptimiserInfo, PathMechanism, PathRun, PathSimulation,
-    PathStat, PhaseTiming, PhysicalParameters, Plane, RankingInfo, ResultsError, RunMetadata,
-    RunResults, SCHEMA_VERSION, SpringParams, StatusCount, TaskRef, TorqueChart, VariantRecord,
-    VariantStatus,
+    EnergyChart, Evaluation, FreeDirection, JointPeak, OptimiserInfo, PathMechanism, PathRun,
+    PathSimulation, PathStat, PhaseTiming, PhysicalParameters, Plane, RankingInfo, ResultsError,
+    RunMetadata, RunResults, SCHEMA_VERSION, SpringParams, StatusCount, TaskRef, TorqueChart,
+    VariantRecord, VariantStatus,
 };
 pub use schematic::{DrawnBody, DrawnCounterweight, DrawnJoint, DrawnSpring, Schematic};

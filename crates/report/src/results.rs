@@ -567,6 +567,26 @@ pub struct RunResults {
     /// geometry from the model's kinematics (filled by the caller; see [`crate::schematic`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub schematics: Vec<Schematic>,
+    /// Potential energy of the unbalanced mechanism and of the recommended variants along a
+    /// path (filled by the caller): flat for a balanced variant.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub energy: Option<EnergyChart>,
+}
+
+/// Potential energy (gravity and springs) along one motion, relative to its first sample, per
+/// mechanism: the unbalanced mechanism first, then variants. A balanced variant's curve is
+/// flat (its energy is constant), which is the whole point of static balancing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EnergyChart {
+    /// What the motion is, in words (`path Lambda`, `task 0→8`).
+    pub along: String,
+    /// What the energy counts, in words (e.g. which payloads).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+    /// Time, s.
+    pub t: Vec<f64>,
+    /// J, `V(t) − V(0)`.
+    pub curves: Vec<Curve>,
 }
 
 impl RunResults {
@@ -587,6 +607,7 @@ impl RunResults {
             decision: None,
             element_bounds: Vec::new(),
             schematics: Vec::new(),
+            energy: None,
         }
     }
 
