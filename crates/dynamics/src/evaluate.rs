@@ -78,7 +78,7 @@ impl Default for EvaluateOptions {
 
 /// How the outputs of a batch's columns are computed by the grid evaluation.
 ///
-/// Both give the same values to rounding (`tests/superposition.rs` of the dynamics crate: the
+/// Both give the same values to rounding (the root package's `tests/superposition.rs`: the
 /// palletizer's joint reaction peaks to 1e-9 relative); each is deterministic per column,
 /// whatever else is in the batch. A study uses one of them throughout, so that its shards
 /// merge into the single run's bits.

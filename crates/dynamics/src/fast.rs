@@ -238,11 +238,7 @@ impl Superposition {
         dst.resize(3 * n * cols, 0.0);
         for da in 0..3 * n {
             let src = &basis[da * nb..(da + 1) * nb];
-            for (d, terms) in dst[da * cols..(da + 1) * cols].iter_mut().zip(&self.terms) {
-                *d = terms
-                    .iter()
-                    .fold(src[0], |acc, &(k, c)| c.mul_add(src[k as usize], acc));
-            }
+            sum_terms(&self.terms, src, &mut dst[da * cols..(da + 1) * cols]);
         }
     }
 
@@ -265,24 +261,50 @@ impl Superposition {
             let dst = &mut dst[row * 4 * cols..(row + 1) * 4 * cols];
             let (d0, rest) = dst.split_at_mut(2 * cols);
             let (dp, dm) = rest.split_at_mut(cols);
-            let g0 = group[0] as usize;
-            for (p, terms) in self.terms.iter().enumerate() {
-                d0[p] = terms.iter().fold(at_zero[0], |acc, &(k, c)| {
-                    c.mul_add(at_zero[k as usize], acc)
-                });
-                let (mut sp, mut sm) = (plus[g0], minus[g0]);
-                for &(k, c) in terms {
-                    if self.inertial[k as usize] {
-                        let g = group[k as usize] as usize;
-                        sp = c.mul_add(plus[g], sp);
-                        sm = c.mul_add(minus[g], sm);
-                    }
-                }
-                dp[p] = sp;
-                dm[p] = sm;
-            }
+            sum_terms(&self.terms, at_zero, &mut d0[..cols]);
+            sum_changes(&self.terms, &self.inertial, group, [plus, minus], [dp, dm]);
         }
     }
+}
+
+crate::simd::multiversion! {
+/// `dst[p] = src[0] + Σ c·src[k]` over column `p`'s terms `(k, c)`, fused multiply-adds in the
+/// terms' order (multiversioned: without the FMA instruction `mul_add` is a library call).
+fn sum_terms(terms: &[Vec<(u32, f64)>], src: &[f64], dst: &mut [f64]) {
+    for (d, terms) in dst.iter_mut().zip(terms) {
+        *d = terms
+            .iter()
+            .fold(src[0], |acc, &(k, c)| c.mul_add(src[k as usize], acc));
+    }
+}
+}
+
+crate::simd::multiversion! {
+/// Every column's changes to `Δ = ±1`: the base column's group's plus `c` times each inertial
+/// term's group's (spring rows do not change with `Δ`), in the terms' order.
+fn sum_changes(
+    terms: &[Vec<(u32, f64)>],
+    inertial: &[bool],
+    group: &[u32],
+    changes: [&[f64]; 2],
+    dst: [&mut [f64]; 2],
+) {
+    let [plus, minus] = changes;
+    let [dp, dm] = dst;
+    let g0 = group[0] as usize;
+    for (p, terms) in terms.iter().enumerate() {
+        let (mut sp, mut sm) = (plus[g0], minus[g0]);
+        for &(k, c) in terms {
+            if inertial[k as usize] {
+                let g = group[k as usize] as usize;
+                sp = c.mul_add(plus[g], sp);
+                sm = c.mul_add(minus[g], sm);
+            }
+        }
+        dp[p] = sp;
+        dm[p] = sm;
+    }
+}
 }
 
 /// Outcome of one sub-task: the statistics of its distinct tasks and, per task, which one
