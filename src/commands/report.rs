@@ -22,6 +22,18 @@ pub fn run(dir: &Path, tolerance: Option<f64>, draw: &[String]) -> Result<ExitCo
     {
         results.element_bounds = super::design::element_bounds(model)?;
     }
+    if let Some(model) = &model
+        && lacks_spring_lengths(&results)
+    {
+        // Written before the shortest spring lengths were recorded: measure them again (the
+        // same configurations as `run`), so the spring specifications can be given.
+        let path = if model.paths.is_empty() {
+            Vec::new()
+        } else {
+            super::run::path_configurations(model, 0)?
+        };
+        super::run::add_practical_figures(model, &mut results, path)?;
+    }
     let tolerance = tolerance
         .or_else(|| results.decision.as_ref().map(|d| d.tolerance))
         .unwrap_or(report::decision::DEFAULT_TOLERANCE);
@@ -59,4 +71,13 @@ pub fn model_of(results: &report::RunResults) -> Option<Model> {
             None
         }
     }
+}
+
+/// Whether some ranked variant's spring has no recorded shortest length.
+fn lacks_spring_lengths(results: &report::RunResults) -> bool {
+    results.ranked().iter().any(|v| {
+        v.practical
+            .as_ref()
+            .is_some_and(|p| p.springs.iter().any(|s| s.shortest.is_none()))
+    })
 }

@@ -744,7 +744,7 @@ const STATIC_STRETCH: f64 = 1e6;
 /// The configurations along path `index`, sampled as [`path_simulation`] samples them (they
 /// are kinematics, the same for every mechanism): where the practical figures take the springs'
 /// peaks, needed before the simulation because the recommendation reads those figures.
-fn path_configurations(model: &Model, index: usize) -> Result<Vec<Vec<f64>>> {
+pub(super) fn path_configurations(model: &Model, index: usize) -> Result<Vec<Vec<f64>>> {
     let params = ParameterSet::from_variants(model, &[Variant::default()])?;
     let series =
         counterpoise_dynamics::path_series(model, &params, 0, index, PATH_SAMPLES_PER_SEGMENT)?;
@@ -869,7 +869,7 @@ fn spring_length(
 /// task-grid points and the samples of the path simulation: the configurations the mechanism
 /// rests in and the one cycle simulated in full. A move between two grid points can pass
 /// through a longer stretch; that is the documented limit of the figure.
-fn add_practical_figures(
+pub(super) fn add_practical_figures(
     model: &Model,
     results: &mut RunResults,
     path_configurations: Vec<Vec<f64>>,

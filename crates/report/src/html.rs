@@ -1,5 +1,5 @@
-//! report.html: one self-contained page (inline CSS and SVG, no scripts, fonts or links) that
-//! opens offline. It is written as XHTML-compatible markup (every element closed, attributes
+//! report.html: one self-contained page (inline CSS, SVG and one inline script that sorts and
+//! filters the ranking table; no fonts, links or network) that opens offline. It is written as XHTML-compatible markup (every element closed, attributes
 //! quoted, only XML entities) so that it parses as XML, which the tests check.
 
 use std::fmt::Write;
@@ -27,6 +27,13 @@ td { white-space: nowrap; }
 td.p { white-space: normal; min-width: 220px; }
 th { background: var(--band); font-weight: 600; vertical-align: bottom; }
 .scroll { overflow-x: auto; max-width: 100%; }
+.scroll.tall { max-height: 70vh; overflow-y: auto; border: 1px solid var(--line); }
+.scroll.tall thead th { position: sticky; top: 0; z-index: 1; }
+table.sortable th[data-sort="asc"]::after { content: " ▲"; }
+table.sortable th[data-sort="desc"]::after { content: " ▼"; }
+.filter { margin: 8px 0 6px; font-size: 13px; }
+.filter label { margin-right: 12px; }
+.filter input, .filter select { font: inherit; padding: 1px 4px; }
 td.n, th.n { text-align: right; }
 td.n { white-space: nowrap; }
 tr.g td { border-top: 2px solid #b9c2c9; }
@@ -118,21 +125,35 @@ pub fn render(r: &RunResults) -> String {
     if ranking.rows.is_empty() {
         h.push_str("<p>No feasible variant to rank.</p>");
     } else {
-        h.push_str(&table(&ranking, ""));
+        h.push_str(&sortable(&ranking, "ranking", r));
         h.push_str(&ranking_note(r));
         h.push_str(OBJECTIVE_NOTE);
         push_charts(&mut h, &charts, Section::Ranking);
-        h.push_str("<h3>Practical figures</h3>");
-        h.push_str(&table(&tables::practical(r), ""));
+        let (detail, all) = detail_variants(r);
+        let of = if all {
+            String::new()
+        } else {
+            format!(
+                " of the recommended and best-ranked variants ({} of {}; every variant in report.md)",
+                detail.len(),
+                r.ranked().len()
+            )
+        };
+        let _ = write!(h, "<h3>Practical figures{}</h3>", esc(&of));
+        h.push_str(&table(&tables::practical_of(r, &detail), ""));
         h.push_str(&practical_note(r));
-        h.push_str("<h3>Optimised parameters (Table 1)</h3>");
-        h.push_str(&table(&tables::parameters(r), ""));
-        h.push_str("<p class=\"note\">Spring: stiffness K, anchor a on the first body and b on the second, as distance and angle in the element's plane (body frames). Counterweight: mass m, offset r and angle φ of its centre of mass in the body frame.</p>");
-        let joints = tables::joint_reactions(r);
+        let _ = write!(h, "<h3>Optimised parameters (Table 1){}</h3>", esc(&of));
+        h.push_str(&table(&tables::parameters_of(r, &detail), ""));
+        h.push_str("<p class=\"note\">Spring: stiffness K, anchor a on the first body and b on the second, as distance and angle in the element's plane (body frames). Counterweight: mass m, offset r and angle φ of its centre of mass in the body frame. Angles in radians, degrees in brackets. <b>(min)</b>, <b>(max)</b>: the value is on that bound of the optimisation (the bound, not the mechanics, decided it); <b>(idle)</b>: the element exerts less than 10⁻³ of the moving mass's weight and does nothing a model can tell (the variant is really the smaller one named in the ranking's Note).</p>");
+        let joints = tables::joint_reactions_of(r, &detail);
         if !joints.rows.is_empty() {
-            h.push_str("<h3>Joint reactions of the ranked variants (ΔR breakdown)</h3>");
+            let _ = write!(
+                h,
+                "<details><summary>Joint reactions (ΔR breakdown){}</summary>",
+                esc(&of)
+            );
             h.push_str(&table(&joints, ""));
-            h.push_str("<p class=\"note\">ΔF_j, ΔM_j: variation of the peak joint force and moment against the unbalanced robot; γ: the joint's share of the unbalanced reactions (Eqs. 20–21); the ΔR term adds the weighted increases only.</p>");
+            h.push_str("<p class=\"note\">ΔF_j, ΔM_j: variation of the peak joint force and moment against the unbalanced robot; γ: the joint's share of the unbalanced reactions (Eqs. 20–21); the ΔR term adds the weighted increases only.</p></details>");
         }
     }
 
@@ -162,23 +183,43 @@ pub fn render(r: &RunResults) -> String {
         }
     }
 
-    let others = tables::not_ranked(r);
+    let mut others = tables::not_ranked(r);
     if !others.rows.is_empty() {
         let _ = write!(
             h,
             "<h2>Variants not ranked</h2><details><summary>{} (reasons)</summary>",
             esc(&not_ranked_summary(r))
         );
+        let total = others.rows.len();
+        if total > NOT_RANKED_ROWS {
+            others.rows.truncate(NOT_RANKED_ROWS);
+            others.group_starts.truncate(NOT_RANKED_ROWS);
+            others.highlighted.truncate(NOT_RANKED_ROWS);
+        }
         h.push_str(&table(&others, ""));
+        if total > NOT_RANKED_ROWS {
+            let _ = write!(
+                h,
+                "<p class=\"note\">The first {NOT_RANKED_ROWS} of {total}, in enumeration order; all of them, with their reasons, in report.md and results.json.</p>"
+            );
+        }
         h.push_str("</details>");
     }
 
-    let ranked = r.ranked();
+    let (ranked, all) = detail_variants(r);
     if !ranked.is_empty() {
         let _ = write!(
             h,
-            "<h2>Appendix</h2><details><summary>Balance relations and free directions of the {} ranked variants</summary>",
-            ranked.len()
+            "<h2>Appendix</h2><details><summary>Balance relations and free directions of {}</summary>",
+            if all {
+                format!("the {} ranked variants", ranked.len())
+            } else {
+                format!(
+                    "the recommended and best-ranked variants ({} of {}; every variant in report.md)",
+                    ranked.len(),
+                    r.ranked().len()
+                )
+            }
         );
         h.push_str("<p class=\"note\">What exact balance imposes on each ranked variant's lifted parameters (m, m·r, K, K·a, K·b, K·a·bᵀ), the freedom left inside the balanced family, and the verification of the optimised parameters (relative spread of the total potential energy at random configurations).</p>");
         for v in &ranked {
@@ -220,6 +261,133 @@ pub fn render(r: &RunResults) -> String {
     h.push('\n');
     h
 }
+
+/// Rows of the "not ranked" table the page shows (all of them are in report.md).
+pub const NOT_RANKED_ROWS: usize = 50;
+/// Rows of the equivalent group the page lists (its summary covers all).
+pub const EQUIVALENT_ROWS: usize = 10;
+/// Up to this many ranked variants, the per-variant tables (Table 1, the ΔR breakdown, the
+/// balance relations) list every one; above it, the recommended and best-ranked ones (the
+/// Dmax 3 palletizer page was 5.4 MB with all 788, 3.6 MB of it these tables).
+pub const DETAIL_ALL: usize = 60;
+
+/// The variants the per-variant tables list, in rank order, and whether that is all of them.
+fn detail_variants(r: &RunResults) -> (Vec<&crate::results::VariantRecord>, bool) {
+    let ranked = r.ranked();
+    if ranked.len() <= DETAIL_ALL {
+        return (ranked, true);
+    }
+    let mut ids: Vec<usize> = tables::design_variants(r).iter().map(|v| v.id).collect();
+    ids.extend(r.shown_variants().iter().map(|v| v.id));
+    (
+        ranked.into_iter().filter(|v| ids.contains(&v.id)).collect(),
+        false,
+    )
+}
+
+/// The ranking as a table the reader can sort (click a header) and filter (class, elements,
+/// ΔQTR) in the browser: plain JavaScript in the page, no network; without scripts it is the
+/// same table in rank order. Numbers are right-aligned by column (one CSS rule per number
+/// column rather than a class on each of thousands of cells).
+fn sortable(t: &Table, id: &str, r: &RunResults) -> String {
+    let mut s = String::new();
+    let numeric: Vec<usize> = (0..t.header.len())
+        .filter(|&c| t.rows.iter().any(|row| row[c].numeric))
+        .collect();
+    let rules: Vec<String> = numeric
+        .iter()
+        .map(|c| format!("#{id} td:nth-child({})", c + 1))
+        .collect();
+    let _ = write!(
+        s,
+        "<style>{} {{ text-align: right; }}</style>",
+        rules.join(", ")
+    );
+    let classes: Vec<&str> = crate::ranking::Class::ALL
+        .iter()
+        .filter(|c| r.ranked().iter().any(|v| v.class == **c))
+        .map(|c| c.name())
+        .collect();
+    let _ = write!(
+        s,
+        "<div class=\"filter\" id=\"{id}-filter\"><label>Class <select data-f=\"class\"><option value=\"\">all</option>{}</select></label> <label>Elements include <input data-f=\"elements\" size=\"14\" placeholder=\"e.g. K43 m4\"/></label> <label>ΔQTR ≤ <input data-f=\"dqtr\" size=\"7\" placeholder=\"e.g. -53.5\"/> %</label> <span class=\"muted\" data-f=\"count\"></span> <span class=\"muted\">· click a header to sort</span></div>",
+        classes
+            .iter()
+            .map(|c| format!("<option>{c}</option>"))
+            .collect::<String>()
+    );
+    let _ = write!(
+        s,
+        "<div class=\"scroll tall\"><table id=\"{id}\" class=\"sortable\"><thead><tr>"
+    );
+    for (c, head) in t.header.iter().enumerate() {
+        if numeric.contains(&c) {
+            let _ = write!(s, "<th class=\"n\">{}</th>", esc(head));
+        } else {
+            let _ = write!(s, "<th>{}</th>", esc(head));
+        }
+    }
+    s.push_str("</tr></thead><tbody>");
+    for (k, row) in t.rows.iter().enumerate() {
+        s.push_str(if t.highlighted.get(k).copied().unwrap_or(false) {
+            "<tr class=\"rec\">"
+        } else {
+            "<tr>"
+        });
+        for cell in row {
+            let _ = write!(s, "<td>{}</td>", esc(&cell.text));
+        }
+        s.push_str("</tr>");
+    }
+    s.push_str("</tbody></table></div>");
+    let _ = write!(
+        s,
+        "<script>//<![CDATA[\n{}\n//]]></script>",
+        SORT_JS.replace("@ID@", id)
+    );
+    s
+}
+
+/// The sorting and filtering of [`sortable`] (ES5, no library).
+const SORT_JS: &str = r#"(function () {
+  var t = document.getElementById('@ID@'), box = document.getElementById('@ID@-filter');
+  if (!t || !box) return;
+  var body = t.tBodies[0], rows = Array.prototype.slice.call(body.rows), head = t.tHead.rows[0].cells;
+  function col(name) { for (var i = 0; i < head.length; i++) if (head[i].textContent === name) return i; return -1; }
+  var ci = col('Class'), ei = col('Elements'), qi = col('ΔQTR [%]');
+  function num(s) { var v = parseFloat(s.replace('−', '-')); return isNaN(v) ? Infinity : v; }
+  function field(f) { return box.querySelector('[data-f="' + f + '"]'); }
+  Array.prototype.forEach.call(head, function (h, i) {
+    h.style.cursor = 'pointer'; h.title = 'sort by this column';
+    h.addEventListener('click', function () {
+      var asc = h.getAttribute('data-sort') !== 'asc', numeric = h.className === 'n';
+      Array.prototype.forEach.call(head, function (x) { x.removeAttribute('data-sort'); });
+      h.setAttribute('data-sort', asc ? 'asc' : 'desc');
+      rows.sort(function (x, y) {
+        var a = x.cells[i].textContent, b = y.cells[i].textContent;
+        var d = numeric ? num(a) - num(b) : a.localeCompare(b);
+        if (d !== d) d = 0;
+        return asc ? d : -d;
+      });
+      rows.forEach(function (r) { body.appendChild(r); });
+    });
+  });
+  function filter() {
+    var c = field('class').value, words = field('elements').value.trim().split(/[\s+]+/).filter(Boolean);
+    var q = parseFloat(field('dqtr').value.replace('−', '-')), shown = 0;
+    rows.forEach(function (r) {
+      var el = ' ' + r.cells[ei].textContent.split(' + ').join(' ') + ' ';
+      var ok = (!c || r.cells[ci].textContent === c) &&
+        words.every(function (w) { return el.indexOf(' ' + w + ' ') >= 0; }) &&
+        (isNaN(q) || num(r.cells[qi].textContent) <= q);
+      r.style.display = ok ? '' : 'none';
+      if (ok) shown++;
+    });
+    field('count').textContent = shown + ' of ' + rows.length + ' shown';
+  }
+  ['class', 'elements', 'dqtr'].forEach(function (f) { field(f).addEventListener('input', filter); });
+  filter();
+})();"#;
 
 /// What the optimiser's two columns mean.
 pub const OBJECTIVE_NOTE: &str = "<p class=\"note\"><b>Objective</b>: the value the optimiser minimised, at the returned parameters, N·m: RMS* (paper Eq. 11, the energy estimate of the motor torques over the critical tasks) or, with <code>--minimax</code>, QTR. <b>Gap</b>: (objective − lower bound) / objective, where the lower bound is certified by the convex relaxation: no parameters within the bounds can improve the objective by more than this fraction (1.0e-3 = 0.1 %).</p>";
@@ -265,16 +433,44 @@ fn push_decision(h: &mut String, r: &RunResults, charts: &[Chart]) {
     let _ = write!(h, "<p class=\"note\"><b>Rule.</b> {}</p>", esc(&d.rule));
     h.push_str(&practical_note(r));
     push_charts(h, charts, Section::Decision);
-    let group = tables::equivalent_group(r);
-    if group.rows.len() > 1 {
+    let mut group = tables::equivalent_group(r);
+    let size = group.rows.len();
+    if size > 1 {
         let _ = write!(
             h,
-            "<details open=\"open\"><summary>The {} variants equivalent to the best-ranked one (within {} percentage points on ΔQTR and ΔQIT)</summary>",
-            group.rows.len(),
-            crate::format::compact(d.tolerance)
+            "<h3>The {size} variants equivalent to the best-ranked one</h3><p>{}</p>",
+            esc(&tables::equivalent_summary(r))
         );
+        if size > EQUIVALENT_ROWS {
+            let keep: Vec<bool> = group
+                .rows
+                .iter()
+                .enumerate()
+                .map(|(k, row)| {
+                    k < EQUIVALENT_ROWS || row.last().is_some_and(|c| c.text == "recommended")
+                })
+                .collect();
+            fn pick<T>(v: Vec<T>, keep: &[bool]) -> Vec<T> {
+                v.into_iter()
+                    .zip(keep)
+                    .filter(|(_, k)| **k)
+                    .map(|(x, _)| x)
+                    .collect()
+            }
+            group.rows = pick(std::mem::take(&mut group.rows), &keep);
+            group.group_starts = pick(std::mem::take(&mut group.group_starts), &keep);
+            group.highlighted = pick(std::mem::take(&mut group.highlighted), &keep);
+            let _ = write!(
+                h,
+                "<p class=\"note\">The first {EQUIVALENT_ROWS} in rank order{}; the whole group is the filter “ΔQTR ≤” of the ranking table below, and is listed in report.md.</p>",
+                if keep.iter().filter(|k| **k).count() > EQUIVALENT_ROWS {
+                    ", and the recommended one"
+                } else {
+                    ""
+                }
+            );
+        }
         h.push_str(&table(&group, ""));
-        h.push_str("</details>");
     }
 }
 

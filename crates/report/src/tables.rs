@@ -560,6 +560,11 @@ pub fn best_per_class(r: &RunResults) -> Table {
 
 /// Per-joint reactions and ΔR terms of every ranked variant.
 pub fn joint_reactions(r: &RunResults) -> Table {
+    joint_reactions_of(r, &r.ranked())
+}
+
+/// [`joint_reactions`] for the given variants only.
+pub fn joint_reactions_of(_r: &RunResults, variants: &[&VariantRecord]) -> Table {
     let mut t = Table::new(&[
         "Variant",
         "Joint",
@@ -571,7 +576,7 @@ pub fn joint_reactions(r: &RunResults) -> Table {
         "γ_M",
         "ΔR term [%]",
     ]);
-    for v in r.ranked() {
+    for v in variants {
         let (Some(e), Some(d)) = (&v.evaluation, &v.dr_terms) else {
             continue;
         };
@@ -787,6 +792,65 @@ pub fn recommendations(r: &RunResults) -> Table {
     t.without_empty_columns()
 }
 
+/// The equivalent group in one sentence: its size, its classes, the spread of its indicators
+/// and practical figures, and how many hold an idle element.
+pub fn equivalent_summary(r: &RunResults) -> String {
+    let Some(rec) = r.decision.as_ref().and_then(|d| d.overall.as_ref()) else {
+        return String::new();
+    };
+    let group: Vec<&VariantRecord> = rec
+        .equivalent
+        .iter()
+        .filter_map(|id| r.variant(*id))
+        .collect();
+    let range = |f: &dyn Fn(&VariantRecord) -> Option<f64>| -> (f64, f64) {
+        group
+            .iter()
+            .filter_map(|v| f(v))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            })
+    };
+    let (q0, q1) = range(&|v| v.dqtr);
+    let (i0, i1) = range(&|v| v.dqit);
+    let (r0, r1) = range(&|v| v.dr);
+    let (m0, m1) = range(&|v| v.practical.as_ref().map(|p| p.added_mass));
+    let classes: Vec<String> = crate::ranking::Class::ALL
+        .iter()
+        .filter_map(|c| {
+            let n = group.iter().filter(|v| v.class == *c).count();
+            (n > 0).then(|| format!("{n} {}", c.name()))
+        })
+        .collect();
+    let idle = group.iter().filter(|v| !v.idle.is_empty()).count();
+    let leader = r
+        .variant(rec.leader)
+        .and_then(|v| v.name.clone())
+        .unwrap_or_default();
+    let mut s = format!(
+        "{} variants ({}) are within {} percentage points of {leader} on ΔQTR and ΔQIT: ΔQTR \
+         {} to {} %, ΔQIT {} to {} %, ΔR {} to {} %, added mass {} to {}",
+        group.len(),
+        classes.join(", "),
+        compact(r.decision.as_ref().map_or(0.0, |d| d.tolerance)),
+        percent(q0),
+        percent(q1),
+        percent(i0),
+        percent(i1),
+        percent(r0),
+        percent(r1),
+        crate::format::mass(m0.max(0.0)),
+        crate::format::mass(m1.max(0.0)),
+    );
+    if idle > 0 {
+        s.push_str(&format!(
+            "; {idle} of them hold an idle element (never recommended)"
+        ));
+    }
+    s.push('.');
+    s
+}
+
 /// The variants equivalent to the overall leader (the material of the overall pick), in rank
 /// order; the pick is marked.
 pub fn equivalent_group(r: &RunResults) -> Table {
@@ -829,11 +893,16 @@ pub fn equivalent_group(r: &RunResults) -> Table {
 
 /// Practical figures of every ranked variant.
 pub fn practical(r: &RunResults) -> Table {
+    practical_of(r, &r.ranked())
+}
+
+/// [`practical`] for the given variants only.
+pub fn practical_of(r: &RunResults, variants: &[&VariantRecord]) -> Table {
     let mut header = vec!["Rank", "Variant", "Elements", "Class"];
     header.extend(PRACTICAL_HEADER);
     let mut t = Table::new(&header);
     let recommended = r.recommended_ids();
-    for v in r.ranked() {
+    for v in variants {
         let mut row = vec![
             Cell::num(v.rank.map(|x| x.to_string()).unwrap_or_default()),
             Cell::text(v.name.clone().unwrap_or_default()),
