@@ -55,6 +55,32 @@ enum Command {
         #[command(flatten)]
         jobs: Jobs,
     },
+    /// Partial balancing: the sets of at most a budget of counterweights, with parameters
+    /// within the case's bounds, that leave the least RMS gravity torque over the workspace on
+    /// the joints that matter, ranked beside the exact search's verdict on each set.
+    Partial {
+        /// Case file (JSON).
+        case: PathBuf,
+        /// Most elements per set (default: the case's `balancing.dmax`).
+        #[arg(long, alias = "dmax", value_name = "N")]
+        budget: Option<usize>,
+        /// Actuators (or the joints they drive) whose gravity torque is minimised, e.g.
+        /// `--joints J2,J3` (default: all).
+        #[arg(long, value_delimiter = ',', value_name = "A,B")]
+        joints: Option<Vec<String>>,
+        /// Workspace values per varying actuator over the task grid's range (default 7, fewer
+        /// when the product would pass the grid-points limit).
+        #[arg(long, value_name = "N")]
+        points: Option<usize>,
+        /// Best designs shown per number of elements.
+        #[arg(long, default_value_t = 5, value_name = "N")]
+        top: usize,
+        /// Print every set's design as JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        jobs: Jobs,
+    },
     /// Phase 1: motor torques, joint reactions and the paper's indicators of the unbalanced
     /// mechanism over its task grid.
     Evaluate {
@@ -216,6 +242,7 @@ fn jobs_of(command: &Command) -> Option<usize> {
     match command {
         Command::Check { jobs, .. }
         | Command::Variants { jobs, .. }
+        | Command::Partial { jobs, .. }
         | Command::Evaluate { jobs, .. }
         | Command::Run { jobs, .. }
         | Command::Merge { jobs, .. } => jobs.jobs,
@@ -246,6 +273,24 @@ fn run(cli: Cli) -> ExitCode {
             minimal,
             ..
         } => commands::variants::run(&case, dmax, json, minimal),
+        Command::Partial {
+            case,
+            budget,
+            joints,
+            points,
+            top,
+            json,
+            ..
+        } => commands::partial::run(
+            &case,
+            commands::partial::Options {
+                budget,
+                joints,
+                points,
+                top,
+                json,
+            },
+        ),
         Command::Evaluate {
             case,
             states: Some(states),

@@ -5,6 +5,7 @@ pub mod design;
 pub mod evaluate;
 pub mod import_urdf;
 pub mod merge;
+pub mod partial;
 pub mod progress;
 pub mod report;
 pub mod run;

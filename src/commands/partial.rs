@@ -1,0 +1,429 @@
+//! `counterpoise partial CASE`: the best partial balancing within a budget of elements — the
+//! sets of counterweights and their parameters, within the case's bounds, that leave the least
+//! RMS gravity torque over the workspace on the joints that matter, ranked, each beside the
+//! exact balance search's verdict on the same set.
+
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use counterpoise_balance::linear::LiftedBasis;
+use counterpoise_balance::partial::{
+    CounterweightLimits, PartialDesign, PartialOptions, PartialReport, TorqueBasis, Workspace,
+    counterweight_entries, partial_search, set_count,
+};
+use counterpoise_balance::search::decide;
+use counterpoise_balance::{
+    Catalogue, Status, VerificationSet, catalogue_options, mechanism_energy, realization_hints,
+};
+use counterpoise_dynamics::Evaluator;
+use counterpoise_model::limits::{Limit, format_count};
+use counterpoise_model::{Model, ModelError};
+use counterpoise_optimise::{BoundsTable, ElementBounds};
+use serde_json::json;
+
+/// Version of the `partial --json` document (documented in README.md).
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// Values per varying actuator of the workspace sample when `--points` is not given (fewer
+/// when their product would exceed the grid-points limit): 7 values see every harmonic of an
+/// arm's gravity torque that a 3-point task grid (both ends and the middle) would not.
+pub const DEFAULT_POINTS: usize = 7;
+
+/// Options of the command.
+pub struct Options {
+    pub budget: Option<usize>,
+    /// Actuator or joint names (`None`: every actuator).
+    pub joints: Option<Vec<String>>,
+    pub points: Option<usize>,
+    /// Best designs shown per size.
+    pub top: usize,
+    pub json: bool,
+}
+
+/// The actuators named by `names` (an actuator's name or its joint's), in actuator order.
+fn select_joints(model: &Model, names: Option<&[String]>) -> Result<Vec<usize>> {
+    let Some(names) = names else {
+        return Ok((0..model.actuators.len()).collect());
+    };
+    let mut picked = Vec::new();
+    for name in names {
+        let name = name.trim();
+        let found = model.actuators.iter().position(|a| {
+            a.name == name || model.joints.get(a.joint).is_some_and(|j| j.name == name)
+        });
+        match found {
+            Some(i) => picked.push(i),
+            None => {
+                let valid: Vec<String> = model
+                    .actuators
+                    .iter()
+                    .map(|a| {
+                        let joint = &model.joints[a.joint].name;
+                        if *joint == a.name {
+                            a.name.clone()
+                        } else {
+                            format!("{} (joint {joint})", a.name)
+                        }
+                    })
+                    .collect();
+                bail!(
+                    "--joints: `{name}` is neither an actuator nor an actuated joint of the case; \
+                     the actuators are {}",
+                    valid.join(", ")
+                );
+            }
+        }
+    }
+    if picked.is_empty() {
+        bail!("--joints: no joint named");
+    }
+    picked.sort_unstable();
+    picked.dedup();
+    Ok(picked)
+}
+
+/// The workspace sample in actuator space: per actuator whose task-grid axis varies, `n`
+/// equally spaced values over that axis; an axis with one value keeps it.
+fn workspace_points(model: &Model, points: Option<usize>) -> Result<(Vec<Vec<f64>>, usize)> {
+    let Some(tasks) = &model.tasks else {
+        bail!("the case has no `tasks` grid: partial balancing samples the workspace over it");
+    };
+    let varying = tasks.grid.iter().filter(|a| a.n > 1).count() as u32;
+    let limit = counterpoise::preflight::limits().get(Limit::GridPoints);
+    let n = match points {
+        Some(n) => {
+            if n < 2 {
+                bail!("--points must be at least 2");
+            }
+            let total = (n as f64).powi(varying as i32);
+            if total > limit as f64 {
+                bail!(
+                    "--points {n}: {} workspace points ({n}^{varying}); the limit is {}; lower \
+                     --points, or {}",
+                    format_count(total),
+                    format_count(limit as f64),
+                    Limit::GridPoints.hint()
+                );
+            }
+            n
+        }
+        None => (2..=DEFAULT_POINTS)
+            .rev()
+            .find(|&n| (n as u64).saturating_pow(varying) <= limit)
+            .unwrap_or(2),
+    };
+    let mut grid = vec![Vec::new()];
+    for axis in &tasks.grid {
+        let values: Vec<f64> = if axis.n > 1 {
+            (0..n)
+                .map(|i| axis.from + (axis.to - axis.from) * i as f64 / (n - 1) as f64)
+                .collect()
+        } else {
+            vec![axis.from]
+        };
+        grid = grid
+            .iter()
+            .flat_map(|p: &Vec<f64>| {
+                values.iter().map(move |&v| {
+                    let mut p = p.clone();
+                    p.push(v);
+                    p
+                })
+            })
+            .collect();
+    }
+    Ok((grid, n))
+}
+
+/// Every counterweight's bounds (the case's `bounds` with its overrides); springs `None`.
+fn limits(model: &Model, catalogue: &Catalogue) -> Result<Vec<Option<CounterweightLimits>>> {
+    let table = BoundsTable::new(model, catalogue)?;
+    Ok(table
+        .entries
+        .iter()
+        .map(|b| match b {
+            ElementBounds::Counterweight(c) => Some(CounterweightLimits {
+                mass: c.mass,
+                radius: c.radius,
+            }),
+            ElementBounds::Spring(_) => None,
+        })
+        .collect())
+}
+
+pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
+    let Some(model) = super::load(path)? else {
+        return Ok(ExitCode::FAILURE);
+    };
+    let Some(balancing) = &model.balancing else {
+        bail!("{}: the case has no `balancing` section", path.display());
+    };
+    let budget = options.budget.unwrap_or(balancing.dmax);
+    if budget == 0 {
+        bail!("--budget must be at least 1");
+    }
+    let started = Instant::now();
+    let joints = select_joints(&model, options.joints.as_deref())?;
+    let energy = mechanism_energy(&model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+    let candidates = counterweight_entries(&catalogue);
+    if candidates.is_empty() {
+        bail!(
+            "{}: `balancing` allows no counterweight (partial balancing covers counterweights \
+             only)",
+            path.display()
+        );
+    }
+    let sets = set_count(&catalogue, budget);
+    let limit = counterpoise::preflight::limits().get(Limit::Variants);
+    if sets > u128::from(limit) {
+        let e = ModelError::Invalid {
+            path: "--budget".into(),
+            reason: format!(
+                "{} sets of at most {budget} counterweights; the limit is {}; lower --budget, or {}",
+                format_count(sets as f64),
+                format_count(limit as f64),
+                Limit::Variants.hint()
+            ),
+        };
+        super::print_errors(path, &super::located(path, vec![e]));
+        return Ok(ExitCode::FAILURE);
+    }
+    let bounds = limits(&model, &catalogue)?;
+    let (targets, per_axis) = workspace_points(&model, options.points)?;
+    let evaluator = Evaluator::new(&model)?;
+    let mut configurations = Vec::with_capacity(targets.len());
+    let mut unreachable = 0;
+    for u in &targets {
+        match evaluator.solve_point(u) {
+            Ok(q) => configurations.push(q),
+            Err(_) => unreachable += 1,
+        }
+    }
+    let workspace = Workspace::new(&model, &configurations);
+    if workspace.is_empty() {
+        bail!(
+            "{}: none of the {} workspace points is reachable with a regular actuator Jacobian",
+            path.display(),
+            targets.len()
+        );
+    }
+    let basis = TorqueBasis::build(&energy, &catalogue, &workspace, &candidates);
+    let report = partial_search(
+        &catalogue,
+        &basis,
+        &bounds,
+        &PartialOptions::new(budget, joints),
+    )?;
+    // The exact verdict of the sets shown: does the set balance at all, whatever the bounds?
+    let shown = shown(&report, options.top);
+    let lifted = LiftedBasis::build(&energy, &catalogue);
+    let checks = VerificationSet::new(&energy);
+    let hints = realization_hints(&model);
+    let verdicts: Vec<Status> = shown
+        .iter()
+        .map(|&i| {
+            decide(
+                &energy,
+                &catalogue,
+                &lifted,
+                &checks,
+                &report.designs[i].entries,
+                hints,
+            )
+            .status
+        })
+        .collect();
+    let seconds = started.elapsed().as_secs_f64();
+    let sample = Sample {
+        requested: targets.len(),
+        per_axis,
+        unreachable,
+        singular: workspace.singular,
+    };
+    if options.json {
+        let doc = to_json(&model, &report, &sample, &shown, &verdicts, seconds);
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+    } else {
+        print!(
+            "{}",
+            tables(&model, &report, &sample, &shown, &verdicts, seconds)
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// How the workspace was sampled.
+struct Sample {
+    requested: usize,
+    per_axis: usize,
+    unreachable: usize,
+    singular: usize,
+}
+
+/// Indices (into the ranking) of the designs shown: the best `top` of each size, in rank order,
+/// leaving out designs with an unused element (the smaller set is ranked on its own).
+fn shown(report: &PartialReport, top: usize) -> Vec<usize> {
+    let mut per_size = vec![0usize; report.budget + 1];
+    let mut out = Vec::new();
+    for (i, d) in report.designs.iter().enumerate() {
+        let size = d.entries.len();
+        if d.unused.is_empty() && per_size[size] < top {
+            per_size[size] += 1;
+            out.push(i);
+        }
+    }
+    out
+}
+
+/// Reduction of `value` against `reference`, in % (negative = less torque).
+fn change(value: f64, reference: f64) -> f64 {
+    if reference > 0.0 {
+        100.0 * (value / reference - 1.0)
+    } else {
+        0.0
+    }
+}
+
+fn design_line(model: &Model, d: &PartialDesign) -> String {
+    d.counterweights
+        .iter()
+        .map(|c| {
+            let label = &model_label(d, c.entry);
+            if d.unused.contains(label) {
+                format!("{label}: unused (0 kg)")
+            } else {
+                let r = c.offset.iter().map(|v| v * v).sum::<f64>().sqrt();
+                format!(
+                    "{label}: m = {:.3} kg at r = ({:.1}, {:.1}, {:.1}) mm (|r| = {:.1} mm, on {})",
+                    c.mass,
+                    c.offset[0] * 1e3,
+                    c.offset[1] * 1e3,
+                    c.offset[2] * 1e3,
+                    r * 1e3,
+                    model.bodies[c.body].name
+                )
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+fn model_label(d: &PartialDesign, entry: usize) -> String {
+    d.entries
+        .iter()
+        .position(|&e| e == entry)
+        .map_or_else(|| "?".into(), |i| d.labels[i].clone())
+}
+
+fn tables(
+    model: &Model,
+    report: &PartialReport,
+    sample: &Sample,
+    shown: &[usize],
+    verdicts: &[Status],
+    seconds: f64,
+) -> String {
+    let names: Vec<&str> = model.actuators.iter().map(|a| a.name.as_str()).collect();
+    let selected: Vec<&str> = report.joints.iter().map(|&j| names[j]).collect();
+    let mut out = format!(
+        "{}: partial balancing with at most {} counterweight(s): {} sets in {:.2} s\n",
+        model.name, report.budget, report.sets, seconds
+    );
+    out.push_str(&format!(
+        "workspace: {} values per varying actuator over the task grid's range → {} points, {} \
+         used ({} unreachable, {} with a singular actuator Jacobian)\n",
+        sample.per_axis, sample.requested, report.points, sample.unreachable, sample.singular
+    ));
+    out.push_str(&format!(
+        "minimised: total RMS gravity torque of {} = √(Σ RMS²) over the workspace (actuator \
+         forces before the ratio, N·m or N)\n",
+        selected.join(", ")
+    ));
+    out.push_str("unbalanced RMS: ");
+    out.push_str(
+        &names
+            .iter()
+            .zip(&report.unbalanced_rms)
+            .map(|(n, v)| format!("{n} {v:.3}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+    );
+    out.push_str(&format!("; total {:.3}\n\n", report.unbalanced_total));
+    out.push_str(&format!(
+        "{:>4}  {:<24} {:>10} {:>8}  {:<12}",
+        "rank", "set", "total", "Δ [%]", "exact"
+    ));
+    for n in &names {
+        out.push_str(&format!(" {:>12}", format!("{n} Δ[%]")));
+    }
+    out.push('\n');
+    for (&i, verdict) in shown.iter().zip(verdicts) {
+        let d = &report.designs[i];
+        out.push_str(&format!(
+            "{:>4}  {:<24} {:>10.3} {:>8.2}  {:<12}",
+            i + 1,
+            d.labels.join(" + "),
+            d.total_rms,
+            change(d.total_rms, report.unbalanced_total),
+            verdict.name()
+        ));
+        for (j, v) in d.rms.iter().enumerate() {
+            out.push_str(&format!(" {:>12.2}", change(*v, report.unbalanced_rms[j])));
+        }
+        out.push('\n');
+        out.push_str(&format!("      {}\n", design_line(model, d)));
+        if d.status != "Solved" {
+            out.push_str(&format!("      solver status: {}\n", d.status));
+        }
+        if let Some(note) = &d.note {
+            out.push_str(&format!("      {note}; lower bound {:.3}\n", d.lower_bound));
+        }
+    }
+    out.push_str(
+        "\ntotal: RMS over the selected joints; Δ: change against the unbalanced mechanism \
+         (negative = less torque); exact: the balance search's verdict on the set, whatever the \
+         bounds (balanced = some parameters balance it perfectly; infeasible = no parameters do, \
+         on every joint); a set whose best design leaves a counterweight at 0 kg is not shown (the \
+         smaller set is).\n",
+    );
+    out
+}
+
+fn to_json(
+    model: &Model,
+    report: &PartialReport,
+    sample: &Sample,
+    shown: &[usize],
+    verdicts: &[Status],
+    seconds: f64,
+) -> serde_json::Value {
+    let names: Vec<&str> = model.actuators.iter().map(|a| a.name.as_str()).collect();
+    let exact: Vec<serde_json::Value> = shown
+        .iter()
+        .zip(verdicts)
+        .map(|(&i, v)| json!({ "rank": i + 1, "status": v.name() }))
+        .collect();
+    json!({
+        "schema_version": SCHEMA_VERSION,
+        "case": model.name,
+        "budget": report.budget,
+        "seconds": seconds,
+        "actuators": names,
+        "joints": report.joints.iter().map(|&j| names[j]).collect::<Vec<_>>(),
+        "workspace": {
+            "per_axis": sample.per_axis,
+            "requested": sample.requested,
+            "points": report.points,
+            "unreachable": sample.unreachable,
+            "singular": sample.singular,
+        },
+        "unbalanced_rms": report.unbalanced_rms,
+        "unbalanced_total": report.unbalanced_total,
+        "sets": report.sets,
+        "exact": exact,
+        "designs": report.designs,
+    })
+}

@@ -1,0 +1,175 @@
+//! `counterpoise partial`: the command against hand calculations (the pendulum's closed form),
+//! joint selection by actuator or joint name, the case's bounds and overrides, and its errors.
+
+mod common;
+
+use common::{assert_success, case_json, counterpoise, stderr, stdout, write_case};
+use serde_json::{Value, json};
+
+const G: f64 = 9.81;
+
+fn run_json(args: &[&str]) -> Value {
+    let out = counterpoise(args);
+    assert_success(&out);
+    serde_json::from_str(&stdout(&out)).expect("JSON on stdout")
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap()
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
+}
+
+/// The pendulum (2 kg rod, centre of mass at 0.5 m, gravity −9.81 y): `τ = 9.81 cos θ`. The
+/// workspace is 7 values of the task grid's [−1.5, 1.5]; with `m ≤ 2 kg` and `|r| ≤ 0.25 m`
+/// the best counterweight is `m·r = (−0.5, 0)` (the grid is symmetric, so `Σ cos θ sin θ = 0`
+/// and the `sin θ` component only adds), which halves the torque: RMS `9.81·0.5·√(mean cos²)`.
+/// The lightest such design is 2 kg at 0.25 m.
+#[test]
+fn pendulum_matches_the_closed_form() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = case_json("pendulum.json");
+    case["balancing"]["bounds"] = json!({ "mass": [0, 2], "radius": [0, 0.25] });
+    let path = write_case(dir.path(), "pendulum.json", &case);
+    let doc = run_json(&["partial", &path, "--json"]);
+    let thetas: Vec<f64> = (0..7).map(|i| -1.5 + 0.5 * i as f64).collect();
+    let mean_cos2 = thetas.iter().map(|t| t.cos().powi(2)).sum::<f64>() / 7.0;
+    let unbalanced = G * mean_cos2.sqrt();
+    assert_eq!(doc["workspace"]["points"], 7);
+    assert!(
+        close(f(&doc["unbalanced_total"]), unbalanced, 1e-9),
+        "{doc}"
+    );
+    let best = &doc["designs"][0];
+    assert_eq!(best["labels"], json!(["m1"]));
+    assert!(
+        close(f(&best["total_rms"]), 0.5 * unbalanced, 1e-6),
+        "{best}"
+    );
+    let cw = &best["counterweights"][0];
+    assert!(close(f(&cw["mass"]), 2.0, 1e-5), "{cw}");
+    assert!(close(f(&cw["offset"][0]), -0.25, 1e-5), "{cw}");
+    assert!(f(&cw["offset"][1]).abs() < 1e-5, "{cw}");
+    // the exact search on that set: one counterweight balances a pendulum (m·r = (−1, 0))
+    assert_eq!(doc["exact"][0], json!({ "rank": 1, "status": "balanced" }));
+}
+
+/// Naming the elbow (by actuator `M2`) or the shoulder (by joint `J1`) changes the answer: the
+/// elbow alone is balanced exactly by `m2` (`m2·r2 = (−1.35, 0)`: link 2's 2.5 kg at 0.3 m and
+/// the 1 kg tool at 0.6 m), and the shoulder's design leaves the shoulder less torque than
+/// the elbow's.
+#[test]
+fn joints_are_chosen_by_actuator_or_joint_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = case_json("two_link.json");
+    case["balancing"]["bounds"] = json!({ "mass": [0, 20], "radius": [0, 1] });
+    let path = write_case(dir.path(), "two_link.json", &case);
+    let elbow = run_json(&[
+        "partial", &path, "--budget", "1", "--joints", "M2", "--json",
+    ]);
+    assert_eq!(elbow["joints"], json!(["M2"]));
+    let best = &elbow["designs"][0];
+    assert_eq!(best["labels"], json!(["m2"]));
+    assert!(
+        f(&best["rms"][1]) < 1e-6 * f(&elbow["unbalanced_rms"][1]),
+        "{best}"
+    );
+    let cw = &best["counterweights"][0];
+    assert!(
+        close(f(&cw["mass"]) * f(&cw["offset"][0]), -1.35, 1e-5),
+        "{cw}"
+    );
+    let shoulder = run_json(&[
+        "partial", &path, "--budget", "1", "--joints", "J1", "--json",
+    ]);
+    assert_eq!(shoulder["joints"], json!(["M1"]));
+    let first = &shoulder["designs"][0];
+    assert!(
+        f(&first["rms"][0]) < 0.9 * f(&best["rms"][0]),
+        "{first} vs {best}"
+    );
+}
+
+/// Every design within the case's bounds, and an override tighter still for `m2`.
+#[test]
+fn bounds_and_overrides_are_respected() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = case_json("two_link.json");
+    case["balancing"]["bounds"] = json!({ "mass": [0, 1.5], "radius": [0, 0.4] });
+    case["balancing"]["overrides"] = json!([{ "element": "m2", "radius": [0, 0.2] }]);
+    let path = write_case(dir.path(), "two_link.json", &case);
+    let doc = run_json(&["partial", &path, "--json"]);
+    assert_eq!(doc["sets"], 3);
+    for d in doc["designs"].as_array().unwrap() {
+        for cw in d["counterweights"].as_array().unwrap() {
+            let m = f(&cw["mass"]);
+            let r = cw["offset"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| f(v).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let r_hi = if cw["entry"] == 1 { 0.2 } else { 0.4 };
+            assert!((-1e-9..=1.5 * (1.0 + 1e-7)).contains(&m), "{cw}");
+            assert!(r <= r_hi * (1.0 + 1e-6), "{cw}");
+        }
+        // never worse than doing nothing (an empty counterweight is within the bounds)
+        assert!(f(&d["total_rms"]) <= f(&doc["unbalanced_total"]) * (1.0 + 1e-9));
+        assert!(f(&d["lower_bound"]) <= f(&d["total_rms"]) * (1.0 + 1e-6));
+    }
+}
+
+/// The table names the exact verdict beside the residual: on the palletizer, `m4` alone
+/// balances exactly (with 1829/8 kg at a radius the bounds do not allow: 0.5 m at most), so
+/// within the bounds it only reduces the torque.
+#[test]
+fn the_table_shows_the_exact_verdict_beside_the_residual() {
+    let out = counterpoise(&[
+        "partial",
+        "cases/palletizer.json",
+        "--budget",
+        "1",
+        "--top",
+        "1",
+    ]);
+    assert_success(&out);
+    let text = stdout(&out);
+    let line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("1  m4 "))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("balanced"), "{line}");
+    assert!(text.contains("343 points, 343 used"), "{text}");
+}
+
+#[test]
+fn bad_options_are_errors_naming_the_option() {
+    for (args, needle) in [
+        (vec!["--joints", "nope"], "--joints: `nope`"),
+        (vec!["--budget", "0"], "--budget must be at least 1"),
+        (vec!["--points", "1"], "--points must be at least 2"),
+    ] {
+        let mut all = vec!["partial", "cases/two_link.json"];
+        all.extend(args);
+        let out = counterpoise(&all);
+        assert_eq!(out.status.code(), Some(1), "{all:?}");
+        assert!(stderr(&out).contains(needle), "{all:?}: {}", stderr(&out));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = case_json("two_link.json");
+    case["balancing"]
+        .as_object_mut()
+        .unwrap()
+        .remove("counterweights");
+    let path = write_case(dir.path(), "springs.json", &case);
+    let out = counterpoise(&["partial", &path]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("allows no counterweight"),
+        "{}",
+        stderr(&out)
+    );
+}
