@@ -818,15 +818,28 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
     let (x_lo, x_hi) = range(chart.points.iter().map(|p| p.x), true);
     // Room left of the lightest points for their markers, clear of the tick labels.
     let x_lo = x_lo - 0.04 * (x_hi - x_lo);
+    let (w, h) = (width - left - right, height - top - bottom);
+    // Room for the largest marker and its ring inside the frame on every side, so none is
+    // clipped at an edge.
+    let pad = chart
+        .points
+        .iter()
+        .map(|p| scatter_radius(p.size, chart.size_max))
+        .fold(0.0f64, f64::max)
+        + 5.0;
+    let (dy, dx) = (
+        pad / h.max(1.0) * (y_hi - y_lo),
+        pad / w.max(1.0) * (x_hi - x_lo),
+    );
     let f = Frame {
         left,
         top,
-        w: width - left - right,
-        h: height - top - bottom,
+        w,
+        h,
         x_lo,
-        x_hi,
-        y_lo,
-        y_hi,
+        x_hi: x_hi + dx,
+        y_lo: y_lo - dy,
+        y_hi: y_hi + dy,
     };
     if let Some((a, b, label)) = &chart.band {
         let (ya, yb) = (f.y(*a), f.y(*b));
@@ -843,6 +856,65 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
     }
     y_axis(&mut out, &f, &chart.y_label);
     x_axis(&mut out, &f, height, &chart.x_label);
+    // Points drawn at the same pixel (e.g. every spring-only variant: no added mass, the same
+    // ΔQTR) are one marker, the largest of them, with their count beside it and all of them
+    // in its tooltip.
+    let mut groups: Vec<(i64, i64, Vec<&ScatterPoint>)> = Vec::new();
+    for p in &chart.points {
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            continue;
+        }
+        let key = (f.x(p.x).round() as i64, f.y(p.y).round() as i64);
+        match groups
+            .iter_mut()
+            .find(|g| g.0 == key.0 && g.1 == key.1 && g.2[0].marker == p.marker)
+        {
+            Some(g) => g.2.push(p),
+            None => groups.push((key.0, key.1, vec![p])),
+        }
+    }
+    // Largest markers first, so small ones stay visible on top.
+    groups.sort_by(|a, b| {
+        let size = |g: &[&ScatterPoint]| g.iter().map(|p| p.size).fold(0.0f64, f64::max);
+        size(&b.2).total_cmp(&size(&a.2))
+    });
+    // Count labels that would overprint another are left out (the tooltip still lists the
+    // group).
+    let mut counts: Vec<(f64, f64)> = Vec::new();
+    for (_, _, g) in &groups {
+        let big = g
+            .iter()
+            .copied()
+            .max_by(|a, b| a.size.total_cmp(&b.size))
+            .expect("a group has a point");
+        let (x, y) = (f.x(big.x), f.y(big.y));
+        let r = scatter_radius(big.size, chart.size_max);
+        let tip = if g.len() == 1 {
+            big.label.clone()
+        } else {
+            let mut lines: Vec<String> = g.iter().take(12).map(|p| p.label.clone()).collect();
+            if g.len() > 12 {
+                lines.push(format!("… and {} more", g.len() - 12));
+            }
+            format!("{} variants at this point:\n{}", g.len(), lines.join("\n"))
+        };
+        let _ = write!(out, "<g><title>{}</title>", escape_html(&tip));
+        marker(&mut out, big.marker, x, y, r, &big.color, false);
+        let (cx, cy) = (x + r + 2.0, y - r + 2.0);
+        let free = counts
+            .iter()
+            .all(|&(px, py)| (px - cx).abs() > 24.0 || (py - cy).abs() > 11.0);
+        if g.len() > 2 && free {
+            counts.push((cx, cy));
+            let _ = write!(
+                out,
+                r##"<text x="{cx:.1}" y="{cy:.1}" font-size="10" fill="#333333">×{}</text>"##,
+                g.len()
+            );
+        }
+        out.push_str("</g>");
+    }
+    // The front on top of the markers and the band, so it stays visible.
     if chart.front.len() > 1 {
         let mut pts = String::new();
         for (k, (x, y)) in chart.front.iter().enumerate() {
@@ -854,38 +926,61 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
         }
         let _ = write!(
             out,
-            r##"<polyline points="{}" fill="none" stroke="#999999" stroke-width="1.2" stroke-dasharray="4 3"><title>non-dominated front (no variant is lighter and better on ΔQTR)</title></polyline>"##,
+            r##"<polyline points="{}" fill="none" stroke="#333333" stroke-width="1.4" stroke-dasharray="5 3"><title>non-dominated front (no variant is lighter and better on ΔQTR)</title></polyline>"##,
             pts.trim_end()
         );
     }
-    // Largest markers first, so small ones stay visible on top.
-    let mut order: Vec<&ScatterPoint> = chart.points.iter().collect();
-    order.sort_by(|a, b| b.size.total_cmp(&a.size));
-    for p in order {
+    // Callouts: points at nearly the same pixel share one label; labels are stacked so none
+    // overprints another.
+    let mut callouts: Vec<(f64, f64, f64, String)> = Vec::new();
+    for p in chart.points.iter().filter(|p| p.callout.is_some()) {
         if !(p.x.is_finite() && p.y.is_finite()) {
             continue;
         }
         let (x, y) = (f.x(p.x), f.y(p.y));
-        let r = scatter_radius(p.size, chart.size_max);
-        let _ = write!(out, "<g><title>{}</title>", escape_html(&p.label));
-        marker(&mut out, p.marker, x, y, r, &p.color, false);
-        out.push_str("</g>");
-    }
-    for p in chart.points.iter().filter(|p| p.callout.is_some()) {
-        let (x, y) = (f.x(p.x), f.y(p.y));
         let r = scatter_radius(p.size, chart.size_max) + 4.0;
-        let text = p.callout.as_deref().unwrap_or_default();
-        // Label to the right unless it would leave the plot.
-        let right_side = x + r + 4.0 + text_width(text, SMALL) < left + f.w;
-        let (tx, anchor) = if right_side {
-            (x + r + 4.0, "start")
+        let text = p.callout.clone().unwrap_or_default();
+        match callouts
+            .iter_mut()
+            .find(|c| (c.0 - x).abs() < 6.0 && (c.1 - y).abs() < 6.0)
+        {
+            Some(c) => {
+                c.2 = c.2.max(r);
+                c.3 = format!("{}; {text}", c.3);
+            }
+            None => callouts.push((x, y, r, text)),
+        }
+    }
+    let mut placed: Vec<(f64, f64, f64, f64)> = Vec::new();
+    for (x, y, r, text) in &callouts {
+        let tw = text_width(text, SMALL);
+        let right_side = x + r + 4.0 + tw < left + f.w;
+        let (tx, anchor, x0) = if right_side {
+            (x + r + 4.0, "start", x + r + 4.0)
         } else {
-            (x - r - 4.0, "end")
+            (x - r - 4.0, "end", x - r - 4.0 - tw)
         };
+        let mut ty = y + 4.0;
+        // Move down (or up near the bottom) until clear of the labels already placed.
+        let clear = |ty: f64, placed: &[(f64, f64, f64, f64)]| {
+            placed.iter().all(|&(px0, py, pw, _)| {
+                (ty - py).abs() >= SMALL + 2.0 || x0 + tw <= px0 || x0 >= px0 + pw
+            })
+        };
+        let step = if ty + 40.0 > top + f.h {
+            -(SMALL + 2.0)
+        } else {
+            SMALL + 2.0
+        };
+        let mut guard = 0;
+        while !clear(ty, &placed) && guard < 20 {
+            ty += step;
+            guard += 1;
+        }
+        placed.push((x0, ty, tw, 0.0));
         let _ = write!(
             out,
-            r##"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="none" stroke="#111111" stroke-width="1.6"/><text x="{tx:.1}" y="{:.1}" font-size="{SMALL}" font-weight="600" text-anchor="{anchor}" stroke="#ffffff" stroke-width="3" paint-order="stroke">{}</text>"##,
-            y + 4.0,
+            r##"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="none" stroke="#111111" stroke-width="1.6"/><text x="{tx:.1}" y="{ty:.1}" font-size="{SMALL}" font-weight="600" text-anchor="{anchor}" stroke="#ffffff" stroke-width="3" paint-order="stroke">{}</text>"##,
             escape_html(text)
         );
     }
@@ -1069,5 +1164,78 @@ mod tests {
             "squares (minus background, frame)"
         );
         assert_eq!(svg.matches("<polygon").count(), 8 + 1, "triangles");
+    }
+
+    #[test]
+    fn pareto_groups_shared_points_merges_callouts_and_clips_nothing() {
+        let pt = |x: f64, y: f64, size: f64, label: &str, callout: Option<&str>| ScatterPoint {
+            x,
+            y,
+            size,
+            color: PALETTE[2].into(),
+            marker: Marker::Square,
+            label: label.into(),
+            callout: callout.map(str::to_string),
+        };
+        // Five spring variants at (0 kg, −54 %), two of them recommended (two callouts at one
+        // point), and the top point with the largest marker.
+        let mut points: Vec<ScatterPoint> = (0..5)
+            .map(|k| pt(0.0, -54.0, 0.0, &format!("SB{k}"), None))
+            .collect();
+        points[1].callout = Some("SB1 (overall)".into());
+        points[2].callout = Some("SB2 (springs)".into());
+        points.push(pt(500.0, -40.0, 10.0, "SB9", None));
+        let svg = scatter_chart(&ScatterChart {
+            title: "t".into(),
+            subtitle: None,
+            x_label: "x".into(),
+            y_label: "y".into(),
+            points,
+            legend: vec![],
+            size_max: 10.0,
+            size_label: "ΔR".into(),
+            band: Some((-54.0, -53.5, "band".into())),
+            front: vec![(0.0, -54.0), (500.0, -55.0)],
+            width: 600.0,
+            height: 400.0,
+        });
+        // One marker for the five, with their count and all of them in the tooltip.
+        assert!(svg.contains("×5"), "{svg}");
+        assert!(svg.contains("5 variants at this point:"));
+        assert_eq!(svg.matches("<title>SB9").count(), 1);
+        // The two callouts share one label.
+        assert!(svg.contains("SB1 (overall); SB2 (springs)"));
+        // The front is drawn after the band (on top of it).
+        assert!(svg.find("<polyline").unwrap() > svg.find("fill=\"#fff3cd\"").unwrap());
+        // The largest marker (11 px) stays inside the frame: its top below the frame's top.
+        let frame_top: f64 = {
+            let k = svg.find("<rect x=").unwrap();
+            let rest = &svg[k..];
+            let rects: Vec<&str> = rest.split("<rect ").collect();
+            // The plot frame is the rect with fill="none".
+            let frame = rects.iter().find(|r| r.contains("fill=\"none\"")).unwrap();
+            let y = frame
+                .split("y=\"")
+                .nth(1)
+                .unwrap()
+                .split('"')
+                .next()
+                .unwrap();
+            y.parse().unwrap()
+        };
+        let poly = svg.split("<polygon").count();
+        let _ = poly;
+        let square_tops: Vec<f64> = svg
+            .split("<rect ")
+            .filter(|r| {
+                r.contains("fill=\"#009E73\"") || r.contains(&format!("fill=\"{}\"", PALETTE[2]))
+            })
+            .filter_map(|r| r.split("y=\"").nth(1)?.split('"').next()?.parse().ok())
+            .collect();
+        assert!(!square_tops.is_empty(), "{svg}");
+        assert!(
+            square_tops.iter().all(|t| *t >= frame_top),
+            "{square_tops:?} vs {frame_top}"
+        );
     }
 }
