@@ -173,3 +173,16 @@ fn bad_options_are_errors_naming_the_option() {
         stderr(&out)
     );
 }
+
+/// `variants` points to `--minimal` and `partial` when nothing balances (the 6-axis arm needs
+/// three elements: `cases/arm6.json` at Dmax 1), and not when something does (the pendulum).
+#[test]
+fn variants_points_to_partial_when_nothing_balances() {
+    let hint = "partial CASE --budget 1";
+    let out = counterpoise(&["variants", "cases/arm6.json", "--dmax", "1"]);
+    assert_success(&out);
+    assert!(stdout(&out).contains(hint), "{}", stdout(&out));
+    let out = counterpoise(&["variants", "cases/pendulum.json", "--dmax", "1"]);
+    assert_success(&out);
+    assert!(!stdout(&out).contains(hint), "{}", stdout(&out));
+}

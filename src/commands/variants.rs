@@ -217,6 +217,14 @@ pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -
         report.count(Status::Balanced) + report.count(Status::Degenerate)
     ));
     out.push_str(&decision_line(report));
+    if report.count(Status::Balanced) + report.count(Status::Degenerate) == 0 {
+        // Where a user goes next: how many elements the robot needs, or what a few can do.
+        out.push_str(&format!(
+            "no variant of at most {dmax} elements balances this mechanism: `variants CASE \
+             --minimal --dmax N` gives the smallest Dmax at which one does, `partial CASE \
+             --budget {dmax}` the counterweights that leave the least gravity torque\n"
+        ));
+    }
     out.push('\n');
     for v in report
         .variants
