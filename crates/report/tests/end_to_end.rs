@@ -676,9 +676,11 @@ fn terminal_summary() {
     assert_eq!(ranking.len(), 1 + 5, "header and five rows: {s}");
     // The optimiser's columns are explained under the table.
     assert!(
-        s.contains("\nObjective: what the optimiser minimised"),
+        s.contains("\nMass: added mass; Spring: peak spring force; Gap:"),
         "{s}"
     );
+    // Within a 120-column terminal (issue 31: it was 174 wide).
+    assert!(s.lines().all(|l| l.chars().count() <= 120), "{s}");
     // The overall recommendation is stated.
     assert!(s.contains("\nRecommended: "), "{s}");
     let mut ranked: Vec<(usize, String)> = r
@@ -694,10 +696,13 @@ fn terminal_summary() {
             "SB{rank} {label} in `{line}`"
         );
     }
-    // Columns line up: the last column is numeric (right-aligned), so every line of the
-    // section has the same width.
-    let widths: Vec<usize> = ranking.iter().map(|l| l.chars().count()).collect();
-    assert!(widths.iter().all(|&w| w == widths[0]), "{widths:?}\n{s}");
+    // Columns line up: the Gap column (numeric, right-aligned) ends at the same place on
+    // every line of the section.
+    let gap_end = ranking[0].find("Gap").unwrap() + 3;
+    for line in &ranking[1..] {
+        let head: String = line.chars().take(ranking[0][..gap_end].chars().count()).collect();
+        assert!(head.ends_with(|c: char| c.is_ascii_digit()), "`{line}`\n{s}");
+    }
 }
 
 #[test]
