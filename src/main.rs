@@ -42,8 +42,8 @@ enum Command {
     Variants {
         /// Case file (JSON).
         case: PathBuf,
-        /// Most elements per variant (default: the case's `balancing.dmax`).
-        #[arg(long)]
+        /// Most elements per variant (default: the case's `balancing.dmax`; at least 1).
+        #[arg(long, value_parser = parse_dmax)]
         dmax: Option<usize>,
         /// Print the full results as JSON instead of tables.
         #[arg(long)]
@@ -114,8 +114,8 @@ enum Command {
     Run {
         /// Case file (JSON).
         case: PathBuf,
-        /// Most elements per variant (default: the case's `balancing.dmax`).
-        #[arg(long)]
+        /// Most elements per variant (default: the case's `balancing.dmax`; at least 1).
+        #[arg(long, value_parser = parse_dmax)]
         dmax: Option<usize>,
         /// Output directory (default: out/<case name>).
         #[arg(long)]
@@ -123,8 +123,10 @@ enum Command {
         /// Minimise QTR over all tasks (constraint generation) instead of the paper's RMS*.
         #[arg(long)]
         minimax: bool,
-        /// Ranking resolution in percentage points: closer values tie.
-        #[arg(long, default_value_t = 0.01)]
+        /// Ranking resolution in percentage points: each indicator is rounded to the nearest
+        /// multiple of it (its cell); variants in the same cell tie on that indicator and the
+        /// next one decides.
+        #[arg(long, default_value_t = 0.01, value_parser = parse_points)]
         resolution: f64,
         /// Equivalence tolerance of the report's decision section, percentage points: variants
         /// whose ΔQTR and ΔQIT are within it of the best-ranked one are compared by added
@@ -411,6 +413,16 @@ fn parse_gap(text: &str) -> Result<f64, String> {
         Ok(x) if x.is_finite() && x > 0.0 && x < 1.0 => Ok(x),
         _ => Err(format!(
             "`{text}` is not a relative gap (a number greater than 0 and less than 1, e.g. 1e-3)"
+        )),
+    }
+}
+
+/// `--dmax`: a positive count (0 is a usage error, exit 2, as every other bad option).
+fn parse_dmax(text: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "`{text}` is not a positive number of elements (at least 1)"
         )),
     }
 }
