@@ -360,6 +360,12 @@ fn tables(
         out.push_str(&format!(" {:>12}", format!("{n} Δ[%]")));
     }
     out.push('\n');
+    if shown.is_empty() {
+        out.push_str(
+            "      (none: every set's best design leaves its counterweights at 0 kg; see the \
+             bounds)\n",
+        );
+    }
     for (&i, verdict) in shown.iter().zip(verdicts) {
         let d = &report.designs[i];
         out.push_str(&format!(

@@ -452,3 +452,26 @@ fn ranking_is_ordered_and_thread_independent() {
         }
     }
 }
+
+/// A mass bound of zero allows no counterweight: every one is reported unused and the residual
+/// is the unbalanced torque.
+#[test]
+fn a_zero_mass_bound_leaves_the_mechanism_as_it_is() {
+    let model = model_of(&case("pendulum.json"));
+    let qs: Vec<Vec<f64>> = spaced(-1.5, 1.5, 7).into_iter().map(|t| vec![t]).collect();
+    let report = search(
+        &model,
+        &qs,
+        CounterweightLimits {
+            mass: [0.0, 0.0],
+            radius: [0.0, 0.0],
+        },
+        1,
+        vec![0],
+    );
+    let best = &report.designs[0];
+    assert_eq!(best.unused, ["m1"]);
+    assert_eq!(best.counterweights[0].mass, 0.0);
+    assert_eq!(best.counterweights[0].offset, [0.0; 3]);
+    assert!(close(best.total_rms, report.unbalanced_total, 1e-12));
+}

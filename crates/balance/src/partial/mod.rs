@@ -280,7 +280,7 @@ fn solve_set(
         };
         let mass = solution.x[block.mass];
         let mut offset = [0.0; 3];
-        if mass > UNUSED_MASS * block.limits.mass[1].max(f64::MIN_POSITIVE) {
+        if block.limits.mass[1] > 0.0 && mass > UNUSED_MASS * block.limits.mass[1] {
             for (&axis, &col) in axes.iter().zip(&block.moment) {
                 offset[axis] = solution.x[col] / mass;
             }
