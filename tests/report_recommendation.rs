@@ -73,3 +73,52 @@ fn torque_charts_and_path_show_the_recommended_variants() {
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains("<tr class=\"rec\">") || html.contains("<tr class=\"g rec\">"));
 }
+
+/// `report DIR --tolerance` re-decides, and the torque curves follow the new recommendation
+/// (issue 31, item 9): at tolerance 0 every scope's recommendation is its best-ranked variant.
+#[test]
+fn report_with_another_tolerance_redraws_the_curves() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = write_case(dir.path(), "tiny.json", &reduced_palletizer(2, 11));
+    let out = dir.path().join("out");
+    assert_success(&counterpoise(&[
+        "run",
+        &case,
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]));
+    let doc = results(&out);
+    assert_success(&counterpoise(&[
+        "report",
+        out.to_str().unwrap(),
+        "--tolerance",
+        "0",
+    ]));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    // Tolerance 0: only variants no worse on ΔQTR and ΔQIT than the leader are equivalent;
+    // the overall leader (SB1) is one, so the overall recommendation is among them. Every
+    // class's best-ranked variant that no other of its class beats on ΔQIT is recommended;
+    // at least SB1's own class leader is, and it is named "recommended" in the torque charts.
+    let sb1 = doc["variants"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|v| v["rank"] == 1)
+        .unwrap();
+    let labels: Vec<&str> = sb1["elements"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["label"].as_str().unwrap())
+        .collect();
+    // At the default tolerance SB1 was not recommended (so its curves were unlabelled).
+    let before: Vec<&serde_json::Value> = std::iter::once(&doc["decision"]["overall"])
+        .chain(doc["decision"]["classes"].as_array().unwrap())
+        .map(|r| &r["chosen"])
+        .collect();
+    assert!(!before.contains(&&sb1["id"]), "SB1 was already recommended");
+    let name = format!("SB1 ({}), recommended", labels.join(" + "));
+    let torque = &html[html.find("Motor torques on the critical tasks").unwrap()..];
+    assert!(torque.contains(&name), "{name} not in the torque charts");
+}

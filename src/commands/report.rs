@@ -40,6 +40,16 @@ pub fn run(dir: &Path, tolerance: Option<f64>, draw: &[String]) -> Result<ExitCo
     results.redecide(tolerance);
     match &model {
         Some(model) => {
+            if charts_are_stale(&results) {
+                // The decision picked variants the stored curves do not show (another
+                // --tolerance, or idle elements marked): compute them again.
+                let m = super::run::shown_mechanisms_of_results(model, &results)?;
+                super::run::add_torque_charts(model, &mut results, &m)?;
+                if !model.paths.is_empty() {
+                    results.path = Some(super::run::path_simulation(model, &m, 0)?.0);
+                }
+                results.finalize_path()?;
+            }
             results.schematics = super::design::schematics(model, &results, draw)?;
             results.energy = super::design::energy_chart(model, &results)?;
         }
@@ -80,4 +90,15 @@ fn lacks_spring_lengths(results: &report::RunResults) -> bool {
             .as_ref()
             .is_some_and(|p| p.springs.iter().any(|s| s.shortest.is_none()))
     })
+}
+
+/// Whether the stored torque curves miss a variant the report now shows.
+fn charts_are_stale(results: &report::RunResults) -> bool {
+    let shown: Vec<usize> = results.shown_variants().iter().map(|v| v.id).collect();
+    let drawn: Vec<usize> = results
+        .torque_charts
+        .first()
+        .map(|c| c.curves.iter().filter_map(|k| k.variant).collect())
+        .unwrap_or_default();
+    shown.iter().any(|id| !drawn.contains(id)) || drawn.iter().any(|id| !shown.contains(id))
 }

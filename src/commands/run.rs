@@ -709,7 +709,7 @@ fn dynamics_variant(model: &Model, opt: &OptimisedRecord) -> Result<Variant> {
 /// The unbalanced robot and the variants the report shows (the best-ranked and the
 /// recommended of each class, [`RunResults::shown_variants`]) as parameter columns, with their
 /// labels (`UB`, then `SB6 (K42 + K43), recommended`-style names) and variant ids.
-struct Mechanisms {
+pub(super) struct Mechanisms {
     params: ParameterSet,
     labels: Vec<(String, Option<usize>)>,
 }
@@ -727,6 +727,51 @@ fn shown_mechanisms(
             continue;
         };
         variants.push(dynamics_variant(model, opt)?);
+        labels.push((results.shown_label(v), Some(v.id)));
+    }
+    Ok(Mechanisms {
+        params: ParameterSet::from_variants(model, &variants)?,
+        labels,
+    })
+}
+
+/// [`shown_mechanisms`] from the parameters stored in the results (`report DIR`, which has no
+/// optimiser records).
+pub(super) fn shown_mechanisms_of_results(
+    model: &Model,
+    results: &RunResults,
+) -> Result<Mechanisms> {
+    let body = |name: &str| {
+        model
+            .body_index(name)
+            .with_context(|| format!("results.json names an unknown body `{name}`"))
+    };
+    let mut variants = vec![Variant::default()];
+    let mut labels = vec![("UB".to_string(), None)];
+    for v in results.shown_variants() {
+        let Some(p) = &v.parameters else { continue };
+        let mut d = Variant::default();
+        for c in &p.counterweights {
+            d.counterweights.push(Counterweight {
+                body: body(&c.body)?,
+                mass: c.mass,
+                position: c.offset,
+            });
+        }
+        for s in &p.springs {
+            d.springs.push(Spring {
+                body: body(&s.body)?,
+                other: if s.other == "base" {
+                    None
+                } else {
+                    Some(body(&s.other)?)
+                },
+                stiffness: s.stiffness,
+                anchor: s.anchor_a,
+                other_anchor: s.anchor_b,
+            });
+        }
+        variants.push(d);
         labels.push((results.shown_label(v), Some(v.id)));
     }
     Ok(Mechanisms {
@@ -753,7 +798,7 @@ pub(super) fn path_configurations(model: &Model, index: usize) -> Result<Vec<Vec
 
 /// The paper's Sec. 3.3 simulation along path `index`: the timed cycle, and the same path
 /// traversed quasi-statically (static torques).
-fn path_simulation(
+pub(super) fn path_simulation(
     model: &Model,
     m: &Mechanisms,
     index: usize,
@@ -917,7 +962,11 @@ pub(super) fn add_practical_figures(
 /// Torque curves (paper Fig. 10-style) of the unbalanced robot and the shown variants (the
 /// best-ranked and the recommended of each class), on the critical RMS and peak tasks of each
 /// of them.
-fn add_torque_charts(model: &Model, results: &mut RunResults, m: &Mechanisms) -> Result<()> {
+pub(super) fn add_torque_charts(
+    model: &Model,
+    results: &mut RunResults,
+    m: &Mechanisms,
+) -> Result<()> {
     let (params, labels) = (&m.params, &m.labels);
     let columns = labels.len();
     let critical = results.critical_tasks();

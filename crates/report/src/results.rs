@@ -689,6 +689,18 @@ impl RunResults {
         Ok(())
     }
 
+    /// Recomputes the path simulation's Table 2 from its dynamic run (after the caller
+    /// replaced the run).
+    pub fn finalize_path(&mut self) -> Result<(), ResultsError> {
+        if let Some(path) = &mut self.path {
+            path.table = match &path.dynamic_run {
+                Some(run) => path_table(&path.name, &path.actuators, run)?,
+                None => Vec::new(),
+            };
+        }
+        Ok(())
+    }
+
     /// Recomputes only the decision, at another tolerance (`counterpoise report --tolerance`).
     pub fn redecide(&mut self, tolerance: f64) {
         self.mark_idle();
