@@ -700,8 +700,14 @@ fn terminal_summary() {
     // every line of the section.
     let gap_end = ranking[0].find("Gap").unwrap() + 3;
     for line in &ranking[1..] {
-        let head: String = line.chars().take(ranking[0][..gap_end].chars().count()).collect();
-        assert!(head.ends_with(|c: char| c.is_ascii_digit()), "`{line}`\n{s}");
+        let head: String = line
+            .chars()
+            .take(ranking[0][..gap_end].chars().count())
+            .collect();
+        assert!(
+            head.ends_with(|c: char| c.is_ascii_digit()),
+            "`{line}`\n{s}"
+        );
     }
 }
 
