@@ -15,7 +15,9 @@
 //! - **splits** the box at the midpoint of the coordinate that carries the largest relaxation
 //!   error (the spring coupling error `|W − αβ/K|` shared by its two anchor components, times
 //!   their relative widths), or, when the springs' error is negligible, of the widest
-//!   counterweight coordinate; midpoint splits shrink every box, so the relaxation converges
+//!   counterweight coordinate (springs first while no design is known, or where the relaxed
+//!   point promised a better design but none was realized); midpoint splits shrink every box,
+//!   so the relaxation converges
 //!   to the true problem and the search terminates;
 //! - **stops** when the best design is within the gap tolerance of the smallest open bound
 //!   (certified optimum), when no box is left (proved impossible), or at the node budget
@@ -514,10 +516,14 @@ pub fn branch_and_bound(
                 value < d.value
             })
         };
+        let was_promising = current.z.as_ref().is_some_and(&promising);
         let found = match &current.z {
             Some(z) if promising(z) => design_at(problem, b, tasks, objective, z, scale),
             _ => None,
         };
+        // Springs first where a design could improve on the best but none was realized here
+        // (or none is known at all): the spring coupling is what keeps designs out of the box.
+        let springs_block = best.is_none() || (was_promising && found.is_none());
         if let Some(d) = found
             && best.as_ref().is_none_or(|bd| d.value < bd.value)
         {
@@ -527,10 +533,11 @@ pub fn branch_and_bound(
             pruned.push((current.node, current.bound));
             continue;
         }
-        let counterweights_first = current.z.as_ref().is_some_and(|z| {
-            let (_, value, _) = merit(problem, tasks, objective, z, scale);
-            value - current.bound > options.gap_tolerance * value.abs()
-        });
+        let counterweights_first = !springs_block
+            && current.z.as_ref().is_some_and(|z| {
+                let (_, value, _) = merit(problem, tasks, objective, z, scale);
+                value - current.bound > options.gap_tolerance * value.abs()
+            });
         let Some(k) = branching_coordinate(problem, &coords, &root, &current, counterweights_first)
         else {
             stuck.push((current.node, current.bound));
