@@ -38,6 +38,25 @@ use crate::regressor::{SampleRegressor, SpringFrame};
 
 /// Relative singular-value threshold of the pseudo-inverse.
 pub const RANK_TOLERANCE: f64 = 1e-10;
+
+/// The pseudo-inverse `A⁺` (`K × 6L`) of a reaction matrix `a` (`6L × K`), dropping singular
+/// values below [`RANK_TOLERANCE`] times the largest. The threshold is relative so that the rank
+/// decision does not depend on the unit of length: `A`'s moment rows scale with the mechanism's
+/// size, and an absolute threshold would call a metre-sized mechanism's rank differently from
+/// the same mechanism drawn in millimetres. Without an SVD (a non-finite entry, no convergence)
+/// every entry is NaN, so the sample's reactions are NaN (the task is then left out as
+/// non-finite), not a made-up number.
+fn pseudo_inverse(a: DMatrix<f64>) -> DMatrix<f64> {
+    let (rows, k) = a.shape();
+    match checked_svd(a, true) {
+        Some(svd) => {
+            let smax = svd.singular_values.max();
+            svd.pseudo_inverse(RANK_TOLERANCE * smax)
+                .unwrap_or_else(|_| DMatrix::zeros(k, rows))
+        }
+        None => DMatrix::from_element(k, rows, f64::NAN),
+    }
+}
 #[derive(Clone, Debug)]
 struct JointInfo {
     kind: JointKind,
@@ -506,17 +525,7 @@ impl ReactionSolver {
                 return;
             }
         }
-        let a = DMatrix::from_column_slice(rows, k, &work.a);
-        // Without an SVD the reactions of the sample are NaN (the task is then left out as
-        // non-finite), not a made-up number.
-        work.pinv = Some(match checked_svd(a, true) {
-            Some(svd) => {
-                let smax = svd.singular_values.max();
-                svd.pseudo_inverse(RANK_TOLERANCE * smax)
-                    .unwrap_or_else(|_| DMatrix::zeros(k, rows))
-            }
-            None => DMatrix::from_element(k, rows, f64::NAN),
-        });
+        work.pinv = Some(pseudo_inverse(DMatrix::from_column_slice(rows, k, &work.a)));
     }
 
     /// Subtracts the actuator wrenches of actuator forces `qu` (`n × nc`, row-major) from the
@@ -1095,6 +1104,7 @@ fn operator_tile<const R: usize, const W: usize>(
 
 #[cfg(test)]
 mod tests {
+    use super::pseudo_inverse;
     use crate::params::{ParameterSet, Variant};
     use crate::runner::{Evaluator, Workspace};
     use counterpoise_model::Case;
@@ -1147,6 +1157,39 @@ mod tests {
                 .chain(ra.moment.iter().zip(&rb.moment))
             {
                 assert!((x - y).amax() <= 1e-9 * scale, "{x} vs {y}");
+            }
+        }
+    }
+
+    /// The rank decision is relative to the largest singular value, so it is the same whatever
+    /// the unit of length. `A = σ₁ q₁ p₁ᵀ + σ₂ q₂ p₂ᵀ` with `q₁ = (0.6, 0.8)`,
+    /// `q₂ = (−0.8, 0.6)`, `p` the unit vectors, `σ₁ = s` a scale far from 1 either way (10⁴: a
+    /// mechanism drawn in tenths of a millimetre; 10⁻⁴) and `σ₂ = ρ s`. By hand
+    /// `A⁺ = Σ pᵢ qᵢᵀ / σᵢ` over the kept values: row `i` is `qᵢ / σᵢ`, 0 where `σᵢ` is dropped.
+    /// At `s = 10⁴`, `ρ = 10⁻¹²` is relatively below [`super::RANK_TOLERANCE`] (numerically
+    /// rank 1): dropped, where a threshold of 10⁻¹⁰ divided by `s` (or not scaled) would keep it
+    /// and put about 10⁸ in the second row. At `s = 10⁻⁴`, `ρ = 10⁻⁸` is above it: kept (second
+    /// row `q₂ / 10⁻¹²`), where the divided threshold (10⁻⁶, or the unscaled 10⁻¹⁰) would drop it.
+    #[test]
+    fn the_pseudo_inverse_rank_decision_does_not_depend_on_the_scale() {
+        let q = [[0.6, 0.8], [-0.8, 0.6]];
+        for (s, rho, kept) in [(1e4, 1e-12, false), (1e-4, 1e-8, true)] {
+            let sigma = [s, rho * s];
+            // A[r][c] = σ_c q_c[r] (p_c the unit vector c)
+            let a = nalgebra::DMatrix::from_fn(2, 2, |r, c| sigma[c] * q[c][r]);
+            let pinv = pseudo_inverse(a);
+            for i in 0..2 {
+                let row = if i == 0 || kept {
+                    [q[i][0] / sigma[i], q[i][1] / sigma[i]]
+                } else {
+                    [0.0, 0.0]
+                };
+                for c in 0..2 {
+                    assert!(
+                        (pinv[(i, c)] - row[c]).abs() <= 1e-9 / sigma[i],
+                        "s = {s}, ρ = {rho}: A⁺ = {pinv}"
+                    );
+                }
             }
         }
     }
