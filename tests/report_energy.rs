@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{assert_success, counterpoise, reduced_palletizer, results, root, write_case};
+use common::{assert_success, counterpoise, results, root, run_reduced_palletizer};
 
 /// (max − min) of a curve.
 fn spread(values: &[f64]) -> f64 {
@@ -104,15 +104,7 @@ fn two_link_energy_is_flat_when_balanced_and_swings_by_hand_when_not() {
 #[test]
 fn palletizer_energy_along_its_path_is_flat_when_balanced() {
     let dir = tempfile::tempdir().unwrap();
-    let case = write_case(dir.path(), "tiny.json", &reduced_palletizer(2, 11));
-    let out = dir.path().join("out");
-    assert_success(&counterpoise(&[
-        "run",
-        &case,
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]));
+    let out = run_reduced_palletizer(dir.path());
     let doc = results(&out);
     assert!(
         doc["energy"]["along"]

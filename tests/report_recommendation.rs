@@ -6,15 +6,12 @@ mod common;
 
 use std::collections::BTreeSet;
 
-use common::{assert_success, counterpoise, reduced_palletizer, results, write_case};
+use common::{assert_success, counterpoise, results, run_reduced_palletizer};
 
 #[test]
 fn torque_charts_and_path_show_the_recommended_variants() {
     let dir = tempfile::tempdir().unwrap();
-    let case = write_case(dir.path(), "tiny.json", &reduced_palletizer(2, 11));
-    let out = dir.path().join("out");
-    let o = counterpoise(&["run", &case, "--out", out.to_str().unwrap(), "--quiet"]);
-    assert_success(&o);
+    let out = run_reduced_palletizer(dir.path());
     let doc = results(&out);
     let decision = &doc["decision"];
     let recommended: BTreeSet<u64> = std::iter::once(&decision["overall"])
@@ -79,15 +76,7 @@ fn torque_charts_and_path_show_the_recommended_variants() {
 #[test]
 fn report_with_another_tolerance_redraws_the_curves() {
     let dir = tempfile::tempdir().unwrap();
-    let case = write_case(dir.path(), "tiny.json", &reduced_palletizer(2, 11));
-    let out = dir.path().join("out");
-    assert_success(&counterpoise(&[
-        "run",
-        &case,
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]));
+    let out = run_reduced_palletizer(dir.path());
     let doc = results(&out);
     assert_success(&counterpoise(&[
         "report",

@@ -8,7 +8,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{assert_success, counterpoise, reduced_palletizer, write_case};
+use common::{assert_success, counterpoise, run_reduced_palletizer};
 
 /// Rows of the table with id `id`.
 fn table_rows(html: &str, id: &str) -> usize {
@@ -20,15 +20,7 @@ fn table_rows(html: &str, id: &str) -> usize {
 #[test]
 fn ranking_table_is_complete_sortable_and_filterable() {
     let dir = tempfile::tempdir().unwrap();
-    let case = write_case(dir.path(), "tiny.json", &reduced_palletizer(2, 11));
-    let out = dir.path().join("out");
-    assert_success(&counterpoise(&[
-        "run",
-        &case,
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]));
+    let out = run_reduced_palletizer(dir.path());
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     let csv = std::fs::read_to_string(out.join("ranking.csv")).unwrap();
     // Every ranked variant (one CSV line each, after the header) is a row of the table.
@@ -87,15 +79,7 @@ fn stored_results_report_is_under_a_megabyte() {
 #[ignore = "needs Debian's chromium"]
 fn ranking_table_filters_and_sorts_in_chromium() {
     let dir = tempfile::tempdir().unwrap();
-    let case = write_case(dir.path(), "tiny.json", &reduced_palletizer(2, 11));
-    let out = dir.path().join("out");
-    assert_success(&counterpoise(&[
-        "run",
-        &case,
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]));
+    let out = run_reduced_palletizer(dir.path());
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     let probe = r#"<script>//<![CDATA[
 window.addEventListener('load', function () {

@@ -66,3 +66,18 @@ pub fn num(v: &serde_json::Value, key: &str) -> f64 {
         .as_f64()
         .unwrap_or_else(|| panic!("{key} is not a number in {v}"))
 }
+
+/// `run` of the palletizer on a 2 × 2 × 2 grid with 11 samples per move (a few seconds: every
+/// report section is there) into `dir/out`; returns that directory.
+pub fn run_reduced_palletizer(dir: &Path) -> PathBuf {
+    let case = write_case(dir, "tiny.json", &reduced_palletizer(2, 11));
+    let out = dir.join("out");
+    assert_success(&counterpoise(&[
+        "run",
+        &case,
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]));
+    out
+}

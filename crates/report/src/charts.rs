@@ -3,7 +3,7 @@
 //! Shared by the HTML writer and the tests that count one `<svg>` per chart.
 
 use crate::ranking::Class;
-use crate::results::{PathRun, RunResults, VariantRecord};
+use crate::results::{Curve, PathRun, RunResults, VariantRecord};
 use crate::svg::{
     BarChart, DASHES, LineChart, LineSeries, Marker, PALETTE, ScatterChart, ScatterPoint,
     bar_chart, line_chart, scatter_chart,
@@ -366,6 +366,26 @@ fn scale<'a>(values: impl Iterator<Item = &'a f64>) -> f64 {
         .fold(0.0f64, |m, v| m.max(v.abs()))
 }
 
+/// One line per curve over the abscissa `t`, styled as every chart of the report styles that
+/// mechanism (UB, the recommended and the best-ranked variants look alike in every figure).
+fn curve_series(r: &RunResults, t: &[f64], curves: &[Curve]) -> Vec<LineSeries> {
+    curves
+        .iter()
+        .enumerate()
+        .map(|(k, curve)| {
+            let (color, dash, marker) = curve_style(r, k, curve.variant);
+            LineSeries {
+                label: curve.label.clone(),
+                color,
+                dash,
+                marker,
+                x: t.to_vec(),
+                y: curve.values.clone(),
+            }
+        })
+        .collect()
+}
+
 /// Potential energy of UB and the recommended variants along one motion: the proof a reader
 /// sees (a balanced variant's line is flat).
 fn energy(r: &RunResults) -> Option<Chart> {
@@ -377,22 +397,7 @@ fn energy(r: &RunResults) -> Option<Chart> {
         x_label: "time [s]".into(),
         y_label: "potential energy [J]".into(),
         y_unit: "J".into(),
-        series: e
-            .curves
-            .iter()
-            .enumerate()
-            .map(|(k, curve)| {
-                let (color, dash, marker) = curve_style(r, k, curve.variant);
-                LineSeries {
-                    label: curve.label.clone(),
-                    color,
-                    dash,
-                    marker,
-                    x: e.t.clone(),
-                    y: curve.values.clone(),
-                }
-            })
-            .collect(),
+        series: curve_series(r, &e.t, &e.curves),
         include_zero: true,
         noise_scale: None,
         width: 560.0,
@@ -422,22 +427,7 @@ fn torque(r: &RunResults) -> Vec<Chart> {
                 x_label: "time [s]".into(),
                 y_label: "motor torque [N·m]".into(),
                 y_unit: "N·m".into(),
-                series: c
-                    .curves
-                    .iter()
-                    .enumerate()
-                    .map(|(k, curve)| {
-                        let (color, dash, marker) = curve_style(r, k, curve.variant);
-                        LineSeries {
-                            label: curve.label.clone(),
-                            color,
-                            dash,
-                            marker,
-                            x: c.t.clone(),
-                            y: curve.values.clone(),
-                        }
-                    })
-                    .collect(),
+                series: curve_series(r, &c.t, &c.curves),
                 include_zero: true,
                 noise_scale: Some(figure_scale),
                 width: 560.0,
