@@ -52,6 +52,84 @@ fn circles<'a>(body: &'a str, key: &str) -> Vec<&'a str> {
         .collect()
 }
 
+/// The labels of a drawing do not overprint each other, and each is beside the point it names
+/// or joined to it by a leader line (issue 31: the palletizer's labels crowded at its sliders).
+/// Boxes are estimated here from the text's position, size and length at 0.55 em a character
+/// (0.6 em bold), about DejaVu Sans's average, from 0.75 em above the baseline to 0.2 em below.
+fn assert_labels_clear(body: &str, what: &str) -> usize {
+    struct Text {
+        text: String,
+        point: (f64, f64),
+        x0: f64,
+        x1: f64,
+        y0: f64,
+        y1: f64,
+        /// The right end at a generous 0.7 em a character (where a leader may end).
+        wide: f64,
+    }
+    let num = |tag: &str, key: &str| attr(tag, key).unwrap().parse::<f64>().unwrap();
+    let texts: Vec<Text> = body
+        .split('<')
+        .filter(|t| t.starts_with("text ") && t.contains(" data-label-x=\""))
+        .map(|t| {
+            let (tag, text) = t.split_once('>').unwrap();
+            let size = num(tag, "font-size");
+            let em = if tag.contains("font-weight") {
+                0.6
+            } else {
+                0.55
+            };
+            let (x, y) = (num(tag, "x"), num(tag, "y"));
+            Text {
+                text: text.to_string(),
+                point: (num(tag, "data-label-x"), num(tag, "data-label-y")),
+                x0: x,
+                x1: x + em * size * text.chars().count() as f64,
+                y0: y - 0.75 * size,
+                y1: y + 0.2 * size,
+                wide: x + 0.7 * size * text.chars().count() as f64,
+            }
+        })
+        .collect();
+    let leaders: Vec<(String, [f64; 4])> = body
+        .split('<')
+        .filter(|t| t.starts_with("line ") && t.contains(" data-leader=\""))
+        .map(|t| {
+            let c = ["x1", "y1", "x2", "y2"].map(|k| num(t, k));
+            (attr(t, "data-leader").unwrap().to_string(), c)
+        })
+        .collect();
+    for (i, a) in texts.iter().enumerate() {
+        for b in &texts[i + 1..] {
+            let w = a.x1.min(b.x1) - a.x0.max(b.x0);
+            let h = a.y1.min(b.y1) - a.y0.max(b.y0);
+            assert!(
+                w <= 0.0 || h <= 0.0,
+                "{what}: labels {} and {} overprint",
+                a.text,
+                b.text
+            );
+        }
+        let (px, py) = a.point;
+        let gap = (px.clamp(a.x0, a.x1) - px).hypot(py.clamp(a.y0, a.y1) - py);
+        let led = leaders.iter().any(|(t, [x1, y1, x2, y2])| {
+            // From the marker's edge (a disc is at most 30 px) to the label's box.
+            *t == a.text
+                && (x1 - px).hypot(y1 - py) <= 32.0
+                && *y2 >= a.y0 - 1.0
+                && *y2 <= a.y1 + 1.0
+                && *x2 >= a.x0 - 1.0
+                && *x2 <= a.wide + 1.0
+        });
+        assert!(
+            gap <= 40.0 || led,
+            "{what}: label {} is {gap:.0} px from its point without a leader",
+            a.text
+        );
+    }
+    texts.len()
+}
+
 struct Drawing {
     q: DVector<f64>,
     right: Vector3<f64>,
@@ -127,6 +205,12 @@ fn check_case(case_path: &str, out: &Path, expected_pose: impl Fn(&Model) -> Vec
             assert!((a - b).abs() < 1e-9, "{case_path}: pose u {u:?}");
         }
         assert!((d.up.norm() - 1.0).abs() < 1e-9 && d.right.dot(&d.up).abs() < 1e-9);
+        // Every body is named, and every element of a variant.
+        let labelled = assert_labels_clear(body, case_path);
+        assert!(
+            labelled >= model.bodies.len(),
+            "{case_path}: {labelled} labels"
+        );
         for tag in circles(body, "data-joint") {
             let name = attr(tag, "data-joint").unwrap();
             let j = model.joints.iter().find(|j| j.name == name).unwrap();

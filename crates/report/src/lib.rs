@@ -58,6 +58,7 @@ pub mod format;
 pub mod honest;
 pub mod html;
 pub mod indicators;
+pub mod labels;
 pub mod markdown;
 pub mod output;
 pub mod practical;

@@ -23,6 +23,7 @@ use std::fmt::Write;
 use serde::{Deserialize, Serialize};
 
 use crate::format::{escape_html as esc, fixed, mass, value};
+use crate::labels::{self, Label, Obstacles, Rect};
 use crate::results::{RunResults, VariantRecord};
 
 /// The geometry of one drawing, world frame, m.
@@ -318,6 +319,11 @@ pub fn svg(r: &RunResults, v: Option<&VariantRecord>, s: &Schematic) -> String {
         r = WIDTH - 16.0,
         t = WIDTH - 34.0
     );
+    // What the labels keep clear of, and the labels, most important first (placed at the end,
+    // drawn on top): the elements' names, then the bodies'.
+    let mut obstacles = Obstacles::default();
+    let mut element_labels: Vec<(Label, &'static str)> = Vec::new();
+    let mut body_labels: Vec<(Label, &'static str)> = Vec::new();
     // Bodies: bars from the first point to the others.
     for b in &s.bodies {
         let Some(&first) = b.points.first() else {
@@ -326,6 +332,7 @@ pub fn svg(r: &RunResults, v: Option<&VariantRecord>, s: &Schematic) -> String {
         let (fx, fy) = px(first);
         for &p in b.points.iter().skip(1).chain(std::iter::once(&b.com)) {
             let (x, y) = px(p);
+            obstacles.bars.push(((fx, fy), (x, y), 3.5));
             let _ = write!(
                 o,
                 "<line x1=\"{fx:.2}\" y1=\"{fy:.2}\" x2=\"{x:.2}\" y2=\"{y:.2}\" stroke=\"#9aa5ad\" stroke-width=\"7\" stroke-linecap=\"round\"/>"
@@ -336,12 +343,19 @@ pub fn svg(r: &RunResults, v: Option<&VariantRecord>, s: &Schematic) -> String {
         let (x, y) = px(b.com);
         let _ = write!(
             o,
-            "<circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"2.5\" fill=\"#5f6b73\" data-com=\"{}\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"10.5\" fill=\"#5f6b73\">{}</text>",
+            "<circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"2.5\" fill=\"#5f6b73\" data-com=\"{}\"/>",
             esc(&b.name),
-            x + 5.0,
-            y + 13.0,
-            esc(&b.name)
         );
+        body_labels.push((
+            Label {
+                text: b.name.clone(),
+                at: (x, y),
+                clear: 2.5,
+                size: 10.5,
+                bold: false,
+            },
+            "#5f6b73",
+        ));
     }
     // Counterweights: an arm from their body, a disc sized by mass.
     for c in &s.counterweights {
@@ -356,14 +370,22 @@ pub fn svg(r: &RunResults, v: Option<&VariantRecord>, s: &Schematic) -> String {
         let idle = idle.contains(&c.label);
         let _ = write!(
             o,
-            "<line x1=\"{fx:.2}\" y1=\"{fy:.2}\" x2=\"{x:.2}\" y2=\"{y:.2}\" stroke=\"#0072B2\" stroke-width=\"2\"/><circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"{rr:.1}\" fill=\"{}\" fill-opacity=\"0.85\" stroke=\"#0072B2\" stroke-width=\"1.5\" data-cw=\"{}\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" font-weight=\"600\" fill=\"#0072B2\">{}{}</text>",
+            "<line x1=\"{fx:.2}\" y1=\"{fy:.2}\" x2=\"{x:.2}\" y2=\"{y:.2}\" stroke=\"#0072B2\" stroke-width=\"2\"/><circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"{rr:.1}\" fill=\"{}\" fill-opacity=\"0.85\" stroke=\"#0072B2\" stroke-width=\"1.5\" data-cw=\"{}\"/>",
             if idle { "#ffffff" } else { "#0072B2" },
             esc(&c.label),
-            x + rr + 4.0,
-            y - 4.0,
-            esc(&c.label),
-            if idle { " (idle)" } else { "" }
         );
+        obstacles.circles.push(((x, y), rr));
+        obstacles.bars.push(((fx, fy), (x, y), 1.0));
+        element_labels.push((
+            Label {
+                text: format!("{}{}", c.label, if idle { " (idle)" } else { "" }),
+                at: (x, y),
+                clear: rr + 1.0,
+                size: 12.0,
+                bold: true,
+            },
+            "#0072B2",
+        ));
     }
     // Springs: attachment lines, the zig-zag, the anchors.
     for sp in &s.springs {
@@ -383,29 +405,37 @@ pub fn svg(r: &RunResults, v: Option<&VariantRecord>, s: &Schematic) -> String {
             esc(&sp.label)
         );
         for (end, (x, y)) in [("a", a), ("b", b)] {
+            obstacles.circles.push(((x, y), 3.5));
             let _ = write!(
                 o,
                 "<circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"3.5\" fill=\"#ffffff\" stroke=\"#009E73\" stroke-width=\"1.8\" data-spring=\"{}\" data-end=\"{end}\"/>",
                 esc(&sp.label)
             );
         }
-        let mid = ((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
-        let _ = write!(
-            o,
-            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" font-weight=\"600\" fill=\"#009E73\">{}{}</text>",
-            mid.0 + 8.0,
-            mid.1 - 6.0,
-            esc(&sp.label),
-            if idle.contains(&sp.label) {
-                " (idle)"
-            } else {
-                ""
-            }
-        );
+        obstacles.bars.push((a, b, 7.0));
+        element_labels.push((
+            Label {
+                text: format!(
+                    "{}{}",
+                    sp.label,
+                    if idle.contains(&sp.label) {
+                        " (idle)"
+                    } else {
+                        ""
+                    }
+                ),
+                at: ((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0),
+                clear: 7.0,
+                size: 12.0,
+                bold: true,
+            },
+            "#009E73",
+        ));
     }
     // Joints on top.
     for j in &s.joints {
         let (x, y) = px(j.at);
+        obstacles.circles.push(((x, y), 5.5));
         if j.grounded {
             let _ = write!(
                 o,
@@ -445,6 +475,64 @@ pub fn svg(r: &RunResults, v: Option<&VariantRecord>, s: &Schematic) -> String {
         x2 = 12.0 + bar * scale,
         ty = PLOT_HEIGHT - 18.0
     );
+    // Labels last, over everything, with a white halo; far ones with a leader line.
+    obstacles.taken.extend([
+        // The title, the gravity arrow, the scale bar.
+        Rect {
+            x0: 0.0,
+            y0: 0.0,
+            x1: 10.0 + labels::text_width(&title, 13.0, true),
+            y1: 24.0,
+        },
+        Rect {
+            x0: WIDTH - 40.0,
+            y0: 8.0,
+            x1: WIDTH,
+            y1: 48.0,
+        },
+        Rect {
+            x0: 0.0,
+            y0: PLOT_HEIGHT - 32.0,
+            x1: 24.0 + bar * scale,
+            y1: PLOT_HEIGHT,
+        },
+    ]);
+    let all: Vec<(Label, &str)> = element_labels.into_iter().chain(body_labels).collect();
+    let area = Rect {
+        x0: 4.0,
+        y0: 4.0,
+        x1: WIDTH - 4.0,
+        y1: PLOT_HEIGHT - 4.0,
+    };
+    let placed = labels::place(
+        &all.iter().map(|(l, _)| l.clone()).collect::<Vec<_>>(),
+        &obstacles,
+        area,
+    );
+    for ((l, color), p) in all.iter().zip(&placed) {
+        if let Some((from, to)) = p.leader {
+            let _ = write!(
+                o,
+                "<line x1=\"{:.2}\" y1=\"{:.2}\" x2=\"{:.2}\" y2=\"{:.2}\" stroke=\"{color}\" stroke-width=\"0.8\" data-leader=\"{}\"/>",
+                from.0,
+                from.1,
+                to.0,
+                to.1,
+                esc(&l.text)
+            );
+        }
+        let _ = write!(
+            o,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"{}\"{} fill=\"{color}\" stroke=\"#ffffff\" stroke-width=\"3\" stroke-linejoin=\"round\" paint-order=\"stroke\" data-label-x=\"{:.2}\" data-label-y=\"{:.2}\">{}</text>",
+            p.rect.x0,
+            p.baseline,
+            l.size,
+            if l.bold { " font-weight=\"600\"" } else { "" },
+            l.at.0,
+            l.at.1,
+            esc(&l.text)
+        );
+    }
     for (k, line) in legend.iter().enumerate() {
         let _ = write!(
             o,
