@@ -10,7 +10,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{assert_success, counterpoise, reduced_palletizer, write_case};
+use common::run_reduced_palletizer;
 use counterpoise_report::{
     Class, CounterweightParams, ElementInfo, ElementKind, Evaluation, JointPeak,
     PhysicalParameters, RankingOptions, RunMetadata, RunResults, SpringParams, VariantRecord,
@@ -226,10 +226,7 @@ fn an_idle_counterweight_is_named_and_never_recommended() {
 #[test]
 fn palletizer_recommendations_hold_no_idle_element() {
     let dir = tempfile::tempdir().unwrap();
-    let case = write_case(dir.path(), "tiny.json", &reduced_palletizer(2, 11));
-    let out = dir.path().join("out");
-    let o = counterpoise(&["run", &case, "--out", out.to_str().unwrap(), "--quiet"]);
-    assert_success(&o);
+    let out = run_reduced_palletizer(dir.path());
     let r = read_results(&out).unwrap();
     assert_no_recommended_idle(&r);
     for v in r.ranked() {
