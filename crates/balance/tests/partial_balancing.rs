@@ -5,6 +5,8 @@
 
 mod common;
 
+use std::sync::OnceLock;
+
 use common::model_of;
 use counterpoise_balance::partial::{
     CounterweightLimits, PartialDesign, PartialOptions, PartialReport, TorqueBasis, Workspace,
@@ -48,34 +50,66 @@ fn grid(axes: &[Vec<f64>]) -> Vec<Vec<f64>> {
     points
 }
 
-/// The search on `model` at configurations `qs`, every counterweight bounded by `limits`.
-fn search(
-    model: &Model,
-    qs: &[Vec<f64>],
-    limits: CounterweightLimits,
-    budget: usize,
-    joints: Vec<usize>,
-) -> PartialReport {
-    search_with(model, qs, limits, PartialOptions::new(budget, joints))
+/// A mechanism at configurations `qs` with what every search on them shares: the catalogue
+/// and the torque basis (the costly part), built once for all the searches of a test, and once
+/// per test binary for the pendulum, which four tests search (see [`pendulum`]).
+struct Setup {
+    model: Model,
+    qs: Vec<Vec<f64>>,
+    catalogue: Catalogue,
+    basis: TorqueBasis,
 }
 
-/// [`search`] with every option given.
-fn search_with(
-    model: &Model,
-    qs: &[Vec<f64>],
-    limits: CounterweightLimits,
-    options: PartialOptions,
-) -> PartialReport {
-    let energy = mechanism_energy(model);
-    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
-    let workspace = Workspace::new(model, qs);
-    assert_eq!(workspace.len(), qs.len(), "every point regular");
-    let cws = counterweight_entries(&catalogue);
-    let basis = TorqueBasis::build(&energy, &catalogue, &workspace, &cws);
-    let bounds: Vec<_> = (0..catalogue.len())
-        .map(|e| cws.contains(&e).then_some(limits))
-        .collect();
-    partial_search(&catalogue, &basis, &bounds, &options).unwrap()
+impl Setup {
+    fn new(model: Model, qs: Vec<Vec<f64>>) -> Setup {
+        let energy = mechanism_energy(&model);
+        let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+        let workspace = Workspace::new(&model, &qs);
+        assert_eq!(workspace.len(), qs.len(), "every point regular");
+        let cws = counterweight_entries(&catalogue);
+        let basis = TorqueBasis::build(&energy, &catalogue, &workspace, &cws);
+        Setup {
+            model,
+            qs,
+            catalogue,
+            basis,
+        }
+    }
+
+    /// The search, every counterweight bounded by `limits`.
+    fn search(
+        &self,
+        limits: CounterweightLimits,
+        budget: usize,
+        joints: Vec<usize>,
+    ) -> PartialReport {
+        self.search_with(limits, PartialOptions::new(budget, joints))
+    }
+
+    /// [`Self::search`] with every option given.
+    fn search_with(&self, limits: CounterweightLimits, options: PartialOptions) -> PartialReport {
+        let cws = counterweight_entries(&self.catalogue);
+        let bounds: Vec<_> = (0..self.catalogue.len())
+            .map(|e| cws.contains(&e).then_some(limits))
+            .collect();
+        partial_search(&self.catalogue, &self.basis, &bounds, &options).unwrap()
+    }
+}
+
+/// The pendulum of `cases/pendulum.json` at 7 angles from −1.5 to 1.5 rad (a grid symmetric
+/// about 0), set up once for the tests that search it.
+fn pendulum() -> &'static Setup {
+    static SETUP: OnceLock<Setup> = OnceLock::new();
+    SETUP.get_or_init(|| {
+        let qs = spaced(-1.5, 1.5, 7).into_iter().map(|t| vec![t]).collect();
+        Setup::new(model_of(&case("pendulum.json")), qs)
+    })
+}
+
+/// The mean of `cos² θ` over the pendulum's angles.
+fn pendulum_mean_cos2() -> f64 {
+    let qs = &pendulum().qs;
+    qs.iter().map(|q| q[0].cos().powi(2)).sum::<f64>() / qs.len() as f64
 }
 
 /// Static actuator forces at `q` from the model's kinematics: every body with its payloads that
@@ -133,13 +167,9 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
 /// `μ = (−r_hi·m_hi, 0)` and the RMS `9.81(1 − r_hi·m_hi)·√(mean cos²)`.
 #[test]
 fn pendulum_with_the_radius_bound_active_matches_the_closed_form() {
-    let model = model_of(&case("pendulum.json"));
-    let thetas = spaced(-1.5, 1.5, 7);
-    let qs: Vec<Vec<f64>> = thetas.iter().map(|&t| vec![t]).collect();
-    let mean_cos2 = thetas.iter().map(|t| t.cos().powi(2)).sum::<f64>() / 7.0;
-    let report = search(
-        &model,
-        &qs,
+    let setup = pendulum();
+    let mean_cos2 = pendulum_mean_cos2();
+    let report = setup.search(
         CounterweightLimits {
             mass: [0.0, 2.0],
             radius: [0.0, 0.25],
@@ -167,7 +197,7 @@ fn pendulum_with_the_radius_bound_active_matches_the_closed_form() {
         best.lower_bound
     );
     // The torque recomputed from the model's kinematics with that counterweight.
-    let rms = recomputed_rms(&model, &qs, best);
+    let rms = recomputed_rms(&setup.model, &setup.qs, best);
     assert!(
         close(rms[0], best.rms[0], 1e-9),
         "{rms:?} vs {:?}",
@@ -178,11 +208,7 @@ fn pendulum_with_the_radius_bound_active_matches_the_closed_form() {
 /// With room for `m·r = (−1, 0)` the pendulum balances: zero residual.
 #[test]
 fn pendulum_balances_when_the_bounds_allow_it() {
-    let model = model_of(&case("pendulum.json"));
-    let qs: Vec<Vec<f64>> = spaced(-1.5, 1.5, 7).into_iter().map(|t| vec![t]).collect();
-    let report = search(
-        &model,
-        &qs,
+    let report = pendulum().search(
         CounterweightLimits {
             mass: [0.0, 4.0],
             radius: [0.0, 1.0],
@@ -208,20 +234,22 @@ fn pendulum_balances_when_the_bounds_allow_it() {
 /// same residual.
 #[test]
 fn a_counterweight_that_does_nothing_is_left_out() {
-    let model = model_of(&case("arm6.json"));
-    let qs = grid(&[
-        vec![0.0],
-        spaced(-3.1, 3.1, 5),
-        spaced(-3.1, 3.1, 5),
-        vec![0.0],
-        vec![0.0],
-        vec![0.0],
-    ]);
+    let setup = Setup::new(
+        model_of(&case("arm6.json")),
+        grid(&[
+            vec![0.0],
+            spaced(-3.1, 3.1, 5),
+            spaced(-3.1, 3.1, 5),
+            vec![0.0],
+            vec![0.0],
+            vec![0.0],
+        ]),
+    );
     let limits = CounterweightLimits {
         mass: [0.0, 30.0],
         radius: [0.0, 0.5],
     };
-    let report = search(&model, &qs, limits, 2, vec![1, 2]);
+    let report = setup.search(limits, 2, vec![1, 2]);
     let find = |labels: &[&str]| {
         report
             .designs
@@ -248,13 +276,9 @@ fn a_counterweight_that_does_nothing_is_left_out() {
 /// relaxation (balance, 0) is the lower bound.
 #[test]
 fn pendulum_radius_lower_bound_is_met_along_the_convex_direction() {
-    let model = model_of(&case("pendulum.json"));
-    let thetas = spaced(-1.5, 1.5, 7);
-    let qs: Vec<Vec<f64>> = thetas.iter().map(|&t| vec![t]).collect();
-    let mean_cos2 = thetas.iter().map(|t| t.cos().powi(2)).sum::<f64>() / 7.0;
-    let report = search(
-        &model,
-        &qs,
+    let setup = pendulum();
+    let mean_cos2 = pendulum_mean_cos2();
+    let report = setup.search(
         CounterweightLimits {
             mass: [3.0, 3.0],
             radius: [0.5, 1.0],
@@ -277,13 +301,16 @@ fn pendulum_radius_lower_bound_is_met_along_the_convex_direction() {
 /// lowers the shoulder's torque below what the elbow's design leaves.
 #[test]
 fn two_link_joint_selection_changes_the_design() {
-    let model = model_of(&case("two_link.json"));
-    let qs = grid(&[spaced(-1.0, 1.0, 7), spaced(-1.5, 1.5, 7)]);
+    let setup = Setup::new(
+        model_of(&case("two_link.json")),
+        grid(&[spaced(-1.0, 1.0, 7), spaced(-1.5, 1.5, 7)]),
+    );
+    let (model, qs) = (&setup.model, &setup.qs);
     let limits = CounterweightLimits {
         mass: [0.0, 20.0],
         radius: [0.0, 1.0],
     };
-    let elbow = search(&model, &qs, limits, 1, vec![1]);
+    let elbow = setup.search(limits, 1, vec![1]);
     let best = &elbow.designs[0];
     assert_eq!(best.labels, ["m2"]);
     assert!(
@@ -295,7 +322,7 @@ fn two_link_joint_selection_changes_the_design() {
     assert!(close(cw.mass * cw.offset[0], -1.35, 1e-6), "{cw:?}");
     assert!((cw.mass * cw.offset[1]).abs() < 1e-6, "{cw:?}");
 
-    let shoulder = search(&model, &qs, limits, 1, vec![0]);
+    let shoulder = setup.search(limits, 1, vec![0]);
     let best_shoulder = &shoulder.designs[0];
     assert!(
         best_shoulder.rms[0] < best.rms[0] * 0.9,
@@ -305,13 +332,13 @@ fn two_link_joint_selection_changes_the_design() {
     );
     // Each design recomputed from the kinematics.
     for d in [best, best_shoulder] {
-        let rms = recomputed_rms(&model, &qs, d);
+        let rms = recomputed_rms(model, qs, d);
         for (a, b) in rms.iter().zip(&d.rms) {
             assert!(close(*a, *b, 1e-9), "{rms:?} vs {:?}", d.rms);
         }
     }
     // Both joints, two elements: the whole arm balances (m1 takes the shoulder's rest).
-    let both = search(&model, &qs, limits, 2, vec![0, 1]);
+    let both = setup.search(limits, 2, vec![0, 1]);
     assert!(both.designs[0].total_rms < 1e-6 * both.unbalanced_total);
     assert_eq!(both.designs[0].labels, ["m1", "m2"]);
 }
@@ -322,34 +349,33 @@ fn two_link_joint_selection_changes_the_design() {
 /// least-squares one, and equal to it when the conic design is strictly inside its bounds.
 #[test]
 fn arm6_conic_optimum_matches_the_normal_equations() {
-    let model = model_of(&case("arm6.json"));
     // shoulder_lift and elbow over their task range, the first wrist at two values.
-    let qs = grid(&[
-        vec![0.3],
-        spaced(-3.1, 3.1, 7),
-        spaced(-3.1, 3.1, 7),
-        vec![-1.0, 0.5],
-        vec![0.0],
-        vec![0.0],
-    ]);
+    let setup = Setup::new(
+        model_of(&case("arm6.json")),
+        grid(&[
+            vec![0.3],
+            spaced(-3.1, 3.1, 7),
+            spaced(-3.1, 3.1, 7),
+            vec![-1.0, 0.5],
+            vec![0.0],
+            vec![0.0],
+        ]),
+    );
+    let (model, qs) = (&setup.model, &setup.qs);
     let joints = vec![1, 2];
     let limits = CounterweightLimits {
         mass: [0.0, 1e3],
         radius: [0.0, 10.0],
     };
     // The least residual alone: the lightest design of the same residual is on the bounds.
-    let report = search_with(
-        &model,
-        &qs,
+    let report = setup.search_with(
         limits,
         PartialOptions {
             lightest: false,
             ..PartialOptions::new(2, joints.clone())
         },
     );
-    let energy = mechanism_energy(&model);
-    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
-    let unbalanced: Vec<DVector<f64>> = qs.iter().map(|q| static_forces(&model, q, &[])).collect();
+    let unbalanced: Vec<DVector<f64>> = qs.iter().map(|q| static_forces(model, q, &[])).collect();
     let mut checked = 0;
     for design in &report.designs {
         // Columns: per counterweight, m at the origin and unit moments along x, y, z.
@@ -358,7 +384,7 @@ fn arm6_conic_optimum_matches_the_normal_equations() {
             for r in [Vector3::zeros(), Vector3::x(), Vector3::y(), Vector3::z()] {
                 let mut col = Vec::new();
                 for (q, ub) in qs.iter().zip(&unbalanced) {
-                    let f = static_forces(&model, q, &[(c.body, 1.0, r)]) - ub;
+                    let f = static_forces(model, q, &[(c.body, 1.0, r)]) - ub;
                     col.extend(joints.iter().map(|&j| f[j]));
                 }
                 columns.push(col);
@@ -406,7 +432,7 @@ fn arm6_conic_optimum_matches_the_normal_equations() {
             );
             checked += 1;
         }
-        let rms = recomputed_rms(&model, &qs, design);
+        let rms = recomputed_rms(model, qs, design);
         for j in &joints {
             assert!(
                 close(rms[*j], design.rms[*j], 1e-9),
@@ -417,7 +443,7 @@ fn arm6_conic_optimum_matches_the_normal_equations() {
     }
     // m2 + m3 and m1 + m2 (the shoulder's counterweight sits on the axis and is free).
     assert!(checked >= 2, "only {checked} sets had an interior optimum");
-    assert_eq!(catalogue.counts().0, 6);
+    assert_eq!(setup.catalogue.counts().0, 6);
 }
 
 /// The ranking is by total residual, and the answer does not depend on the thread count.
@@ -429,12 +455,13 @@ fn ranking_is_ordered_and_thread_independent() {
         mass: [0.0, 2.0],
         radius: [0.0, 0.3],
     };
-    let many = search(&model, &qs, limits, 2, vec![0, 1]);
+    let many = Setup::new(model.clone(), qs.clone()).search(limits, 2, vec![0, 1]);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
         .unwrap();
-    let one = pool.install(|| search(&model, &qs, limits, 2, vec![0, 1]));
+    // the set-up too on one thread: the torque basis is built in parallel
+    let one = pool.install(|| Setup::new(model, qs).search(limits, 2, vec![0, 1]));
     assert_eq!(many.designs.len(), 3);
     for w in many.designs.windows(2) {
         assert!(w[0].total_rms <= w[1].total_rms);
@@ -457,11 +484,7 @@ fn ranking_is_ordered_and_thread_independent() {
 /// is the unbalanced torque.
 #[test]
 fn a_zero_mass_bound_leaves_the_mechanism_as_it_is() {
-    let model = model_of(&case("pendulum.json"));
-    let qs: Vec<Vec<f64>> = spaced(-1.5, 1.5, 7).into_iter().map(|t| vec![t]).collect();
-    let report = search(
-        &model,
-        &qs,
+    let report = pendulum().search(
         CounterweightLimits {
             mass: [0.0, 0.0],
             radius: [0.0, 0.0],
