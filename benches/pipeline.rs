@@ -20,6 +20,11 @@
 
 use std::time::Duration;
 
+#[path = "../tests/common/variants.rs"]
+mod variants;
+
+use variants::dynamics_variant;
+
 use counterpoise_balance::{
     Catalogue, SearchOptions, Status, VariantResult, catalogue_options, mechanism_energy,
     realization_hints, search,
@@ -65,33 +70,6 @@ fn study(model: &Model, dmax: usize) -> Vec<OptimisedVariant> {
     let variants = balanced(model, dmax);
     let ctx = Context::new(model, Some(ub.indicators.swap_remove(0))).expect("context");
     optimise_all(&ctx, &variants, &OptimiseOptions::default())
-}
-
-/// The dynamics crate's variant of an optimised record.
-fn variant(model: &Model, o: &OptimisedVariant) -> Variant {
-    let body = |name: &str| model.body_index(name).expect("a body of the model");
-    Variant {
-        counterweights: o
-            .counterweights
-            .iter()
-            .map(|c| Counterweight {
-                body: body(&c.body),
-                mass: c.mass,
-                position: c.offset,
-            })
-            .collect(),
-        springs: o
-            .springs
-            .iter()
-            .map(|s| Spring {
-                body: body(&s.body),
-                other: (s.other != "base").then(|| body(&s.other)),
-                stiffness: s.stiffness,
-                anchor: s.anchor_a,
-                other_anchor: s.anchor_b,
-            })
-            .collect(),
-    }
 }
 
 /// `count` three-element variants over the bodies and spring slots of the palletizer's
@@ -171,7 +149,7 @@ fn pipeline(c: &mut Criterion) {
     let finals: Vec<Variant> = study(&model, 2)
         .iter()
         .filter(|o| o.is_feasible())
-        .map(|o| variant(&model, o))
+        .map(|o| dynamics_variant(&model, o))
         .collect();
     let params = ParameterSet::from_variants(&model, &finals).expect("variants");
     let mut group = c.benchmark_group("final_grid");

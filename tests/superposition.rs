@@ -8,6 +8,8 @@ mod common;
 
 use std::time::Instant;
 
+use common::variants::dynamics_variant;
+
 use counterpoise_balance::{
     Catalogue, SearchOptions, Status, catalogue_options, mechanism_energy, realization_hints,
     search,
@@ -17,35 +19,8 @@ use counterpoise_dynamics::{
     Combination, Counterweight, EvaluateOptions, Indicators, Spring, Variant, evaluate_grid,
     evaluate_grid_indicators_with,
 };
-use counterpoise_model::{Case, Model};
-use counterpoise_optimise::{Context, OptimiseOptions, OptimisedVariant, optimise_all};
-
-/// The dynamics crate's variant of an optimised record (bodies by name, `base` for none).
-fn variant(model: &Model, o: &OptimisedVariant) -> Variant {
-    let body = |name: &str| model.body_index(name).expect("a body of the model");
-    Variant {
-        counterweights: o
-            .counterweights
-            .iter()
-            .map(|c| Counterweight {
-                body: body(&c.body),
-                mass: c.mass,
-                position: c.offset,
-            })
-            .collect(),
-        springs: o
-            .springs
-            .iter()
-            .map(|s| Spring {
-                body: body(&s.body),
-                other: (s.other != "base").then(|| body(&s.other)),
-                stiffness: s.stiffness,
-                anchor: s.anchor_a,
-                other_anchor: s.anchor_b,
-            })
-            .collect(),
-    }
-}
+use counterpoise_model::Case;
+use counterpoise_optimise::{Context, OptimiseOptions, optimise_all};
 
 /// `|a − b|` relative to `max(|a|, |b|, floor)`: a peak that is exactly zero in one method
 /// (a joint the variant leaves unloaded) may be a rounding residue in the other.
@@ -83,7 +58,7 @@ fn every_reaction_peak_of_every_feasible_dmax2_variant_equals_the_direct_solve()
     let variants: Vec<Variant> = optimised
         .iter()
         .filter(|o| o.is_feasible())
-        .map(|o| variant(&model, o))
+        .map(|o| dynamics_variant(&model, o))
         .collect();
     // README: 50 feasible variants at Dmax 2, of every class
     assert_eq!(variants.len(), 50);
