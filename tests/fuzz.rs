@@ -18,10 +18,12 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
-use std::process::{Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
+mod common;
+
+use common::process::{Ran, run_binary};
 use counterpoise::balance::{
     Catalogue, SearchOptions, catalogue_options, mechanism_energy, realization_hints, search,
 };
@@ -369,45 +371,6 @@ fn mutate_extreme(v: &mut Value, rng: &mut SplitMix64, values: &[f64]) -> String
     }
 }
 
-/// How one run of the binary ended.
-enum Ran {
-    /// Exited with this status and standard error.
-    Exited(i32, String),
-    /// Ended by a signal (an abort, a stack overflow).
-    Signalled(String),
-    /// Still running at the deadline (killed).
-    Hung,
-}
-
-/// Runs the binary with `args` until `deadline`, killing it past that. Standard output is
-/// dropped (a case's summary is not under test) and standard error goes to a file, so that
-/// neither pipe can fill and stall the child.
-fn run_binary(args: &[&str], dir: &Path, deadline: Instant) -> Ran {
-    let err_path = dir.join("stderr");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_counterpoise"))
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(std::fs::File::create(&err_path).unwrap())
-        .spawn()
-        .expect("the binary runs");
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status;
-        }
-        if Instant::now() >= deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Ran::Hung;
-        }
-        std::thread::sleep(Duration::from_millis(1));
-    };
-    let stderr = std::fs::read_to_string(&err_path).unwrap_or_default();
-    match status.code() {
-        Some(code) => Ran::Exited(code, stderr),
-        None => Ran::Signalled(format!("{status:?}: {stderr}")),
-    }
-}
-
 /// The field paths of the errors the binary printed: its error lines are
 /// `  joints[9].axis: reason (line 442, column 7)`.
 fn error_paths(stderr: &str) -> Vec<String> {
@@ -431,7 +394,11 @@ struct CaseAnswer {
 /// failure without a message.
 fn not_an_answer(ran: Ran) -> Result<(i32, String), String> {
     match ran {
-        Ran::Hung => Err(format!("no answer within {BUDGET:?}")),
+        Ran::Hung(used) => Err(format!(
+            "no answer within {BUDGET:?}{}",
+            used.map(|t| format!(" (it had used {:.1} s of processor time)", t.as_secs_f64()))
+                .unwrap_or_default()
+        )),
         Ran::Signalled(what) => Err(format!("ended by a signal ({what})")),
         Ran::Exited(_, stderr) if stderr.contains("panicked") => Err(format!("panic: {stderr}")),
         Ran::Exited(code, stderr) if !(0..=2).contains(&code) => {

@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+pub mod process;
 pub mod variants;
 
 /// The workspace root, where `cases/` lives.
