@@ -14,10 +14,13 @@ pub mod angle;
 pub mod display;
 pub mod expr;
 pub mod field;
+pub mod field_surd;
 pub mod geometry;
 pub mod monomial;
+pub mod ordered;
 pub mod poly;
 pub mod scalar;
+pub mod surd;
 
 pub use angle::LinearAngle;
 pub use expr::{
@@ -25,7 +28,10 @@ pub use expr::{
     MAX_EXPRESSION_LENGTH,
 };
 pub use field::{ExactConstant, Field};
+pub use field_surd::SurdConstant;
 pub use geometry::{ExactMat3, ExactVec3, Mat3, PolyMat3, PolyVec3, Vec3};
 pub use monomial::{MAX_VARS, Monomial, VarKind};
+pub use ordered::{Ordered, RefArith};
 pub use poly::{ExactPoly, Point, Poly, TrigPoly};
 pub use scalar::{Rational, Scalar, decimal_to_rational, rational_to_f64};
+pub use surd::Surd;
