@@ -10,9 +10,7 @@
 
 use std::collections::BTreeMap;
 
-use counterpoise_symbolic::{
-    ExactContext, ExactMat3, ExactPoly, ExactVec3, Field, Poly, Rational, VarKind,
-};
+use counterpoise_symbolic::{Context, Field, Mat3, Poly, Rational, Surd, VarKind, Vec3};
 
 use crate::case::Expr;
 use crate::model::{BodyId, Model};
@@ -20,21 +18,26 @@ use crate::pose::{Parser, SymbolicPose};
 
 /// One body's exact world pose: `x_world = origin + rotation · x_body`.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ExactFrame {
-    pub rotation: ExactMat3,
-    pub origin: ExactVec3,
+pub struct ExactFrame<F = Rational> {
+    pub rotation: Mat3<F>,
+    pub origin: Vec3<F>,
 }
 
 /// What the exact balance decision needs: gravity, every body's pose and the unbalanced energy,
-/// all with rational coefficients.
+/// all with coefficients in the exact field `F` (ℚ, or ℚ(√2, √3) for rotations by multiples of
+/// π/12).
 #[derive(Clone, Debug, PartialEq)]
-pub struct ExactMechanism {
-    pub gravity: [Rational; 3],
+pub struct ExactMechanism<F = Rational> {
+    pub gravity: [F; 3],
     /// In the model's body order.
-    pub bodies: Vec<ExactFrame>,
+    pub bodies: Vec<ExactFrame<F>>,
     /// Gravitational potential of the bodies and the payloads marked `in_balance` (J).
-    pub unbalanced: ExactPoly,
+    pub unbalanced: Poly<F>,
 }
+
+/// The mechanism over ℚ(√2, √3): for cases whose rotations are multiples of π/12 (π/6, π/4
+/// and their sums), which ℚ refuses.
+pub type SurdMechanism = ExactMechanism<Surd>;
 
 /// Why a case cannot be taken exactly: the field and the reason.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -51,18 +54,23 @@ fn not_exact(path: impl Into<String>, reason: impl Into<String>) -> NotExact {
     }
 }
 
-fn literal(x: f64, path: &str) -> Result<Rational, NotExact> {
-    let constant = Rational::literal(x).map_err(|r| not_exact(path, r))?;
-    Rational::to_scalar(&constant).map_err(|r| not_exact(path, r))
+fn literal<F: Field>(x: f64, path: &str) -> Result<F, NotExact> {
+    let constant = F::literal(x).map_err(|r| not_exact(path, r))?;
+    F::to_scalar(&constant).map_err(|r| not_exact(path, r))
 }
 
-/// Builds the exact mechanism of a validated model, or says which field prevents it.
+/// Builds the exact mechanism of a validated model over ℚ, or says which field prevents it.
 pub fn exact_mechanism(model: &Model) -> Result<ExactMechanism, NotExact> {
+    exact_mechanism_in::<Rational>(model)
+}
+
+/// Builds the exact mechanism over the field `F`, or says which field of the case prevents it.
+pub fn exact_mechanism_in<F: Field>(model: &Model) -> Result<ExactMechanism<F>, NotExact> {
     let case = &model.case;
     let mut parameters = BTreeMap::new();
     for (name, value) in case.parameters.iter() {
         let constant =
-            Rational::literal(*value).map_err(|r| not_exact(format!("parameters.{name}"), r))?;
+            F::literal(*value).map_err(|r| not_exact(format!("parameters.{name}"), r))?;
         parameters.insert(name.to_string(), constant);
     }
     let coordinates: Vec<(String, VarKind)> = model
@@ -70,7 +78,7 @@ pub fn exact_mechanism(model: &Model) -> Result<ExactMechanism, NotExact> {
         .iter()
         .map(|c| (c.name.clone(), c.kind))
         .collect();
-    let context = ExactContext::new(parameters, coordinates);
+    let context = Context::<F>::new(parameters, coordinates);
     let parser = Parser { context: &context };
 
     let first_error = |errors: Vec<crate::ModelError>, path: String| -> NotExact {
@@ -91,11 +99,11 @@ pub fn exact_mechanism(model: &Model) -> Result<ExactMechanism, NotExact> {
         let pose = parser.pose(&body.pose, &path, &mut errors);
         relative.push(pose.ok_or_else(|| first_error(errors, path))?);
     }
-    let mut world: Vec<Option<SymbolicPose<Rational>>> = vec![None; case.bodies.len()];
+    let mut world: Vec<Option<SymbolicPose<F>>> = vec![None; case.bodies.len()];
     for i in 0..model.bodies.len() {
         world_pose(model, &relative, &mut world, i);
     }
-    let bodies: Vec<ExactFrame> = world
+    let bodies: Vec<ExactFrame<F>> = world
         .into_iter()
         .map(|p| {
             let p = p.expect("every body's world pose was composed");
@@ -107,28 +115,28 @@ pub fn exact_mechanism(model: &Model) -> Result<ExactMechanism, NotExact> {
         .collect();
 
     let gravity = [
-        literal(case.gravity[0], "gravity[0]")?,
-        literal(case.gravity[1], "gravity[1]")?,
-        literal(case.gravity[2], "gravity[2]")?,
+        literal::<F>(case.gravity[0], "gravity[0]")?,
+        literal::<F>(case.gravity[1], "gravity[1]")?,
+        literal::<F>(case.gravity[2], "gravity[2]")?,
     ];
-    let point = |exprs: &[Expr; 3], path: &str| -> Result<[Rational; 3], NotExact> {
+    let point = |exprs: &[Expr; 3], path: &str| -> Result<[F; 3], NotExact> {
         let mut errors = Vec::new();
         let constants = parser
             .constant_vec(exprs, path, &mut errors)
             .ok_or_else(|| first_error(errors, path.to_string()))?;
-        let mut out: [Rational; 3] = Default::default();
+        let mut out: [F; 3] = Default::default();
         for (k, c) in constants.iter().enumerate() {
-            out[k] = Rational::to_scalar(c).map_err(|r| not_exact(format!("{path}[{k}]"), r))?;
+            out[k] = F::to_scalar(c).map_err(|r| not_exact(format!("{path}[{k}]"), r))?;
         }
         Ok(out)
     };
-    let mut unbalanced = ExactPoly::zero();
+    let mut unbalanced = Poly::<F>::zero();
     for (i, body) in case.bodies.iter().enumerate() {
         if body.mass == 0.0 {
             continue;
         }
         let path = format!("bodies[{i}]");
-        let mass = literal(body.mass, &format!("{path}.mass"))?;
+        let mass = literal::<F>(body.mass, &format!("{path}.mass"))?;
         let com = match &body.com {
             Some(com) => point(com, &format!("{path}.com"))?,
             None => Default::default(),
@@ -141,7 +149,7 @@ pub fn exact_mechanism(model: &Model) -> Result<ExactMechanism, NotExact> {
         }
         let path = format!("payloads[{j}]");
         let body = model.payloads[j].body;
-        let mass = literal(payload.mass, &format!("{path}.mass"))?;
+        let mass = literal::<F>(payload.mass, &format!("{path}.mass"))?;
         let com = point(&payload.com, &format!("{path}.com"))?;
         unbalanced += &gravity_potential(&bodies[body], &gravity, &mass, com);
     }
@@ -153,24 +161,24 @@ pub fn exact_mechanism(model: &Model) -> Result<ExactMechanism, NotExact> {
 }
 
 /// `−m g·(p + R c)`: the potential of mass `m` at `c` in the frame's body axes.
-fn gravity_potential(
-    frame: &ExactFrame,
-    gravity: &[Rational; 3],
-    mass: &Rational,
-    com: [Rational; 3],
-) -> ExactPoly {
+fn gravity_potential<F: Field>(
+    frame: &ExactFrame<F>,
+    gravity: &[F; 3],
+    mass: &F,
+    com: [F; 3],
+) -> Poly<F> {
     let world = frame.origin.add(&frame.rotation.mul_const_vec(com));
-    world.dot_const(gravity.clone()).scale(-mass.clone())
+    world.dot_const(gravity.clone()).scale(mass.neg_ref())
 }
 
 /// Composes body `i`'s world pose from its parent's (memoised; the parent relation is acyclic
 /// in a validated model).
-fn world_pose(
+fn world_pose<F: Field>(
     model: &Model,
-    relative: &[SymbolicPose<Rational>],
-    world: &mut Vec<Option<SymbolicPose<Rational>>>,
+    relative: &[SymbolicPose<F>],
+    world: &mut Vec<Option<SymbolicPose<F>>>,
     i: usize,
-) -> SymbolicPose<Rational> {
+) -> SymbolicPose<F> {
     if let Some(pose) = &world[i] {
         return pose.clone();
     }
@@ -182,7 +190,7 @@ fn world_pose(
     pose
 }
 
-impl ExactMechanism {
+impl<F: Field> ExactMechanism<F> {
     /// The exact energy with coefficients rounded to doubles (for comparison with the model).
     pub fn unbalanced_f64(&self) -> counterpoise_symbolic::TrigPoly {
         Poly::to_f64(&self.unbalanced)
@@ -192,7 +200,7 @@ impl ExactMechanism {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use counterpoise_symbolic::Monomial;
+    use counterpoise_symbolic::{ExactPoly, Monomial};
     use num_bigint::BigInt;
 
     fn q(n: i64, d: i64) -> Rational {

@@ -28,7 +28,9 @@ use std::path::Path;
 
 pub use case::Case;
 pub use error::{CaseErrors, ModelError, Position};
-pub use exact::{ExactFrame, ExactMechanism, NotExact, exact_mechanism};
+pub use exact::{
+    ExactFrame, ExactMechanism, NotExact, SurdMechanism, exact_mechanism, exact_mechanism_in,
+};
 pub use kinematics::{BodyJacobian, BodyMotion, Kinematics, Pose};
 pub use limits::{Limit, Limits};
 pub use model::{
