@@ -219,9 +219,17 @@ pub fn summary(model: &Model) -> String {
                 b.dmax
             ),
         );
+        // The search's order: ℚ, then ℚ(√2, √3), then floating point.
         let decision = match counterpoise_model::exact_mechanism(model) {
-            Ok(_) => "exact (every number of the case is rational)".to_string(),
-            Err(e) => format!("numeric, with an ambiguous zone reported as undecided ({e})"),
+            Ok(_) => "exact over ℚ (every number of the case is rational)".to_string(),
+            Err(_) => {
+                match counterpoise_model::exact_mechanism_in::<counterpoise_symbolic::Surd>(model) {
+                    Ok(_) => "exact over ℚ(√2, √3) (rotations by multiples of π/12)".to_string(),
+                    Err(e) => format!(
+                        "numeric: {e} (floating point, with an ambiguous zone reported as undecided)"
+                    ),
+                }
+            }
         };
         line(&mut out, format!("balance decision: {decision}"));
         if let Some(note) = super::derived_bounds_note(model) {

@@ -4,7 +4,7 @@
 //! Kept separate from the case model so that tests can build small mechanisms by hand and so that
 //! the search depends only on poses and energies, never on how they were described.
 
-use counterpoise_model::ExactMechanism;
+use counterpoise_model::{ExactMechanism, SurdMechanism};
 use counterpoise_symbolic::{PolyMat3, PolyVec3, TrigPoly, VarKind};
 
 /// The symbolic world pose of one body: `x_world = origin + rotation · x_body`.
@@ -31,6 +31,9 @@ pub struct MechanismEnergy {
     /// The same mechanism in exact rationals, or why its numbers cannot be taken exactly (the
     /// search then decides numerically and says so).
     pub exact: Result<ExactMechanism, String>,
+    /// The mechanism over ℚ(√2, √3) when `exact` failed (rotations by multiples of π/12), or why
+    /// that field cannot hold it either (the search then decides numerically with that reason).
+    pub surd: Result<SurdMechanism, String>,
 }
 
 impl MechanismEnergy {

@@ -20,7 +20,8 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::element::Catalogue;
 use crate::energy::MechanismEnergy;
-use crate::exact::{ExactBasis, ExactSolution};
+use crate::exact::{ExactBasis, ExactField, ExactSolution};
+use counterpoise_symbolic::{RefArith, Surd};
 
 /// Relative singular value above which a direction certainly counts (numeric path).
 pub const RANK_TOL: f64 = 1e-9;
@@ -45,6 +46,9 @@ pub struct LiftedBasis {
     pub elements: Vec<DMatrix<f64>>,
     /// The exact basis, when the case's numbers are rational.
     pub exact: Option<ExactBasis>,
+    /// The exact basis over ℚ(√2, √3), when the case is not rational but every rotation is a
+    /// multiple of π/12 (tried only when `exact` is `None`).
+    pub surd: Option<ExactBasis<Surd>>,
 }
 
 impl LiftedBasis {
@@ -90,6 +94,10 @@ impl LiftedBasis {
                 .as_ref()
                 .ok()
                 .map(|mechanism| ExactBasis::build(mechanism, catalogue)),
+            surd: match (&energy.exact, &energy.surd) {
+                (Err(_), Ok(mechanism)) => Some(ExactBasis::build(mechanism, catalogue)),
+                _ => None,
+            },
         }
     }
 
@@ -136,8 +144,24 @@ pub struct LinearSolution {
 /// Solves one variant's balance system: exactly when the basis has an exact part, in floating
 /// point otherwise.
 pub fn solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
-    match &basis.exact {
-        Some(exact) => {
+    match (&basis.exact, &basis.surd) {
+        (Some(exact), _) => solve_exact(basis, exact, elements),
+        (None, Some(surd)) => solve_exact(basis, surd, elements),
+        (None, None) => numeric_solve(basis, elements),
+    }
+}
+
+/// [`solve`] over the exact field `F`.
+fn solve_exact<F: ExactField>(
+    basis: &LiftedBasis,
+    exact: &ExactBasis<F>,
+    elements: &[usize],
+) -> LinearSolution
+where
+    for<'a> &'a F: RefArith<F>,
+{
+    {
+        {
             let solution = exact.solve(elements);
             if solution.consistent() {
                 // Where confident floating point agrees with the exact facts its SVD basis spans
@@ -161,7 +185,6 @@ pub fn solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
                 numeric
             }
         }
-        None => numeric_solve(basis, elements),
     }
 }
 
@@ -169,8 +192,10 @@ pub fn solve(basis: &LiftedBasis, elements: &[usize]) -> LinearSolution {
 /// floating point), in the numeric path's conventions: the free directions orthonormal in
 /// column-scaled units and the particular solution of least scaled norm. The exact family
 /// decides what the span is; this only picks the same basis of it that an SVD would.
-pub fn from_exact(basis: &LiftedBasis, solution: &ExactSolution) -> LinearSolution {
-    use counterpoise_symbolic::rational_to_f64;
+pub fn from_exact<F: ExactField>(basis: &LiftedBasis, solution: &ExactSolution<F>) -> LinearSolution
+where
+    for<'a> &'a F: RefArith<F>,
+{
     let (matrix, offsets) = basis.system(&solution.elements);
     let cols = matrix.ncols();
     let column_scale = column_norms(&matrix);
@@ -180,10 +205,10 @@ pub fn from_exact(basis: &LiftedBasis, solution: &ExactSolution) -> LinearSoluti
             .particular
             .iter()
             .zip(column_scale.iter())
-            .map(|(x, s)| rational_to_f64(x) * s),
+            .map(|(x, s)| x.to_f64() * s),
     );
     let scaled_null = DMatrix::from_fn(cols, solution.nullspace.len(), |j, f| {
-        rational_to_f64(&solution.nullspace[f][j]) * column_scale[j]
+        solution.nullspace[f][j].to_f64() * column_scale[j]
     });
     let orthonormal = if scaled_null.ncols() == 0 {
         scaled_null
@@ -647,6 +672,7 @@ mod tests {
             unbalanced: DVector::from_row_slice(&b),
             elements: vec![DMatrix::from_fn(3, 2, |i, j| a[i][j])],
             exact: None,
+            surd: None,
         }
     }
 

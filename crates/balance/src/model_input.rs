@@ -9,6 +9,7 @@ use crate::realize::RealizationHints;
 /// The mechanism as the search sees it: every body's pose and the unbalanced energy of the bodies
 /// plus the payloads marked `in_balance`.
 pub fn mechanism_energy(model: &Model) -> MechanismEnergy {
+    let (exact, surd) = exact_fields(model);
     MechanismEnergy {
         kinds: model.kinds(),
         ranges: model
@@ -27,7 +28,27 @@ pub fn mechanism_energy(model: &Model) -> MechanismEnergy {
             })
             .collect(),
         unbalanced: model.potential_energy(PayloadMode::InBalance),
-        exact: counterpoise_model::exact_mechanism(model).map_err(|e| e.to_string()),
+        exact,
+        surd,
+    }
+}
+
+/// The case over ℚ, else over ℚ(√2, √3) (built only when ℚ refuses it), each with the reason it
+/// cannot be taken.
+#[allow(clippy::type_complexity)]
+fn exact_fields(
+    model: &Model,
+) -> (
+    Result<counterpoise_model::ExactMechanism, String>,
+    Result<counterpoise_model::SurdMechanism, String>,
+) {
+    match counterpoise_model::exact_mechanism(model) {
+        Ok(m) => (Ok(m), Err("the case is exact over ℚ".to_string())),
+        Err(e) => (
+            Err(e.to_string()),
+            counterpoise_model::exact_mechanism_in::<counterpoise_symbolic::Surd>(model)
+                .map_err(|e| e.to_string()),
+        ),
     }
 }
 

@@ -4,12 +4,12 @@
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use counterpoise_symbolic::{Rational, rational_to_f64};
+use counterpoise_symbolic::RefArith;
 use num_traits::Signed;
 
 use crate::element::{CatalogueEntry, Element};
 use crate::exact::positivity::{self, Bound};
-use crate::exact::{ExactSolution, exact_text};
+use crate::exact::{ExactField, ExactSolution, exact_text};
 use crate::linear::{FIXED_TOL, LinearSolution};
 
 /// One free direction of the balanced family: moving along it keeps the energy constant.
@@ -194,7 +194,14 @@ pub fn free_directions(
 
 /// The balance relations of an exact solution, solved for the earliest variable of each and
 /// written exactly: `m4 = 1829/8 (228.625) kg`, `K43·ax − 1/4 (0.25)·K43·bx = 0 N`.
-pub fn exact_relations(solution: &ExactSolution, names: &[String], units: &[&str]) -> Vec<String> {
+pub fn exact_relations<F: ExactField>(
+    solution: &ExactSolution<F>,
+    names: &[String],
+    units: &[&str],
+) -> Vec<String>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     solution
         .echelon
         .relations()
@@ -203,8 +210,8 @@ pub fn exact_relations(solution: &ExactSolution, names: &[String], units: &[&str
             let mut lhs = names[pivot].clone();
             for (j, c) in terms {
                 let sign = if c.is_negative() { "−" } else { "+" };
-                let magnitude = c.abs();
-                if magnitude == Rational::from_integer(1.into()) {
+                let magnitude = if c.is_negative() { -c } else { c };
+                if magnitude == F::one() {
                     lhs.push_str(&format!(" {sign} {}", names[j]));
                 } else {
                     lhs.push_str(&format!(" {sign} {}·{}", exact_text(&magnitude), names[j]));
@@ -229,7 +236,7 @@ pub struct AdmissibleRange {
     pub interval: String,
 }
 
-fn interval_text(low: &Option<Bound>, high: &Option<Bound>) -> String {
+fn interval_text<F: ExactField>(low: &Option<Bound<F>>, high: &Option<Bound<F>>) -> String {
     let open = match low {
         Some(b) if b.closed => format!("[{}", exact_text(&b.value)),
         Some(b) => format!("({}", exact_text(&b.value)),
@@ -245,12 +252,15 @@ fn interval_text(low: &Option<Bound>, high: &Option<Bound>) -> String {
 
 /// Ranges of every mass, stiffness, first moment `m·r` and spring moment `K·a`, `K·b` (the
 /// products `K·a·b` are left out: they follow from the others) over the positive family.
-pub fn admissible_ranges(
-    solution: &ExactSolution,
+pub fn admissible_ranges<F: ExactField>(
+    solution: &ExactSolution<F>,
     entries: &[(usize, &CatalogueEntry)],
     names: &[String],
     units: &[&'static str],
-) -> Vec<AdmissibleRange> {
+) -> Vec<AdmissibleRange>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     let heads = solution.heads();
     let mut out = Vec::new();
     for (k, (_, entry)) in entries.iter().enumerate() {
@@ -266,8 +276,8 @@ pub fn admissible_ranges(
             out.push(AdmissibleRange {
                 variable: names[j].clone(),
                 unit: units[j],
-                low: r.low.as_ref().map(|b| rational_to_f64(&b.value)),
-                high: r.high.as_ref().map(|b| rational_to_f64(&b.value)),
+                low: r.low.as_ref().map(|b| b.value.to_f64()),
+                high: r.high.as_ref().map(|b| b.value.to_f64()),
                 interval: interval_text(&r.low, &r.high),
             });
         }

@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::element::{Attachment, Catalogue, CatalogueEntry, Element};
 use crate::energy::MechanismEnergy;
 use crate::enumerate::variants;
-use crate::exact::{ExactBasis, ExactSolution, positivity, rank_one};
+use crate::exact::{ExactBasis, ExactField, ExactSolution, positivity, rank_one};
 use crate::linear::{LiftedBasis, solve};
 use crate::realize::{Realization, RealizationHints, Witness, find_witness, realize};
 use crate::relations::{
@@ -16,6 +16,7 @@ use crate::relations::{
     free_directions, variable_units,
 };
 use crate::verify::{Verification, VerificationSet};
+use counterpoise_symbolic::RefArith;
 
 /// What the search concluded about a variant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
@@ -219,9 +220,11 @@ pub fn decide(
 ) -> VariantResult {
     let entries: Vec<_> = set.iter().map(|&e| (e, &catalogue.entries[e])).collect();
     let mut result = new_result(energy, &entries);
-    match &basis.exact {
-        Some(exact) => decide_exact(basis, exact, checks, &entries, hints, &mut result),
-        None => decide_numeric(basis, checks, &entries, hints, &mut result),
+    // ℚ first, then ℚ(√2, √3), then floating point (the basis holds the first that applies).
+    match (&basis.exact, &basis.surd) {
+        (Some(exact), _) => decide_exact(basis, exact, checks, &entries, hints, &mut result),
+        (None, Some(surd)) => decide_exact(basis, surd, checks, &entries, hints, &mut result),
+        (None, None) => decide_numeric(basis, checks, &entries, hints, &mut result),
     }
     result
 }
@@ -255,16 +258,19 @@ fn names_and_units(entries: &[(usize, &CatalogueEntry)]) -> (Vec<String>, Vec<&'
     (names, units)
 }
 
-/// The exact path: every linear fact and every proof in rational arithmetic; only the witness
-/// is found in floating point, and it is verified by sampling the physical energy.
-fn decide_exact(
+/// The exact path: every linear fact and every proof in exact arithmetic (over ℚ or
+/// ℚ(√2, √3)); only the witness is found in floating point, and it is verified by sampling the
+/// physical energy.
+fn decide_exact<F: ExactField>(
     numeric: &LiftedBasis,
-    exact: &ExactBasis,
+    exact: &ExactBasis<F>,
     checks: &VerificationSet,
     entries: &[(usize, &CatalogueEntry)],
     hints: RealizationHints,
     result: &mut VariantResult,
-) {
+) where
+    for<'a> &'a F: RefArith<F>,
+{
     result.decision = Decision::Exact;
     let set: Vec<usize> = entries.iter().map(|(e, _)| *e).collect();
     let solution = exact.solve(&set);
@@ -284,11 +290,7 @@ fn decide_exact(
     }
     result.nullity = solution.nullity();
     for (k, &(e, entry)) in entries.iter().enumerate() {
-        if exact.elements[e]
-            .iter()
-            .flatten()
-            .all(num_traits::Zero::is_zero)
-        {
+        if exact.elements[e].iter().flatten().all(F::entry_is_zero) {
             result.redundant.push(entry.label.clone());
         } else if solution.contribution_forced_zero(exact, k) {
             result.idle.push(entry.label.clone());
@@ -364,10 +366,13 @@ fn decide_exact(
 
 /// Proofs of unrealizability from signs, in exact arithmetic: a mass or stiffness fixed at zero
 /// or below, or no positive point of the family (Farkas certificate).
-fn exact_sign_proof(
-    solution: &ExactSolution,
+fn exact_sign_proof<F: ExactField>(
+    solution: &ExactSolution<F>,
     entries: &[(usize, &CatalogueEntry)],
-) -> Option<String> {
+) -> Option<String>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     for (k, (_, entry)) in entries.iter().enumerate() {
         let head = solution.offsets[k];
         if !solution.is_fixed(head) || solution.fixed_positive(head) {
@@ -378,7 +383,7 @@ fn exact_sign_proof(
             Element::Counterweight { .. } => ("mass", "kg"),
             Element::Spring { .. } => ("stiffness", "N/m"),
         };
-        return Some(if num_traits::Zero::is_zero(value) {
+        return Some(if value.is_zero() {
             format!("{}: balance forces its {what} to zero", entry.label)
         } else {
             format!(
@@ -394,9 +399,9 @@ fn exact_sign_proof(
             .multipliers
             .iter()
             .zip(entries)
-            .filter(|(m, _)| !num_traits::Zero::is_zero(*m))
+            .filter(|(m, _)| !m.is_zero())
             .map(|(m, (_, entry))| {
-                if m.is_integer() && *m.numer() == 1.into() {
+                if *m == F::one() {
                     entry.label.clone()
                 } else {
                     format!("{}·{}", crate::exact::exact_text(m), entry.label)
@@ -415,11 +420,14 @@ fn exact_sign_proof(
 /// For every spring whose anchor `a` (or `b`) balance fixes — `K·a = a₀·K` on the whole family —
 /// the equations `W = a₀ βᵀ` (or `W = α b₀ᵀ`) a physical spring must satisfy, as rows over the
 /// variant's variables; and the anchors, described.
-fn fixed_anchor_equations(
-    solution: &ExactSolution,
+#[allow(clippy::type_complexity)]
+fn fixed_anchor_equations<F: ExactField>(
+    solution: &ExactSolution<F>,
     entries: &[(usize, &CatalogueEntry)],
-) -> (Vec<String>, Vec<Vec<counterpoise_symbolic::Rational>>) {
-    use counterpoise_symbolic::Rational;
+) -> (Vec<String>, Vec<Vec<F>>)
+where
+    for<'a> &'a F: RefArith<F>,
+{
     let n = solution.echelon.columns;
     let mut anchors = Vec::new();
     let mut rows = Vec::new();
@@ -430,16 +438,16 @@ fn fixed_anchor_equations(
         let (na, nb) = (axes_a.len(), axes_b.len());
         let start = solution.offsets[k];
         let (alpha, beta, w) = (start + 1, start + 1 + na, start + 1 + na + nb);
-        let describe = |side: &str, v: &[Rational]| {
+        let describe = |side: &str, v: &[F]| {
             let values: Vec<String> = v.iter().map(crate::exact::exact_text).collect();
             format!("{}'s anchor {side} = ({})", entry.label, values.join(", "))
         };
         // W_ij − (fixed factor)·(free factor) = 0 for every component.
-        let mut push_rows = |fixed: &[Rational], free_start: usize, a_fixed: bool| {
+        let mut push_rows = |fixed: &[F], free_start: usize, a_fixed: bool| {
             for i in 0..na {
                 for j in 0..nb {
-                    let mut row = vec![Rational::from_integer(0.into()); n];
-                    row[w + i * nb + j] = Rational::from_integer(1.into());
+                    let mut row = vec![F::zero(); n];
+                    row[w + i * nb + j] = F::one();
                     let (f, v) = if a_fixed { (i, j) } else { (j, i) };
                     row[free_start + v] = -fixed[f].clone();
                     rows.push(row);
@@ -590,6 +598,7 @@ mod tests {
             }],
             unbalanced: TrigPoly::sin(0).scale(9.81),
             exact: Err("built by hand".into()),
+            surd: Err("built by hand".into()),
         }
     }
 
@@ -743,6 +752,7 @@ mod tests {
             unbalanced: DVector::from_iterator(rows, value.iter().map(|&v| -v as f64)),
             elements: vec![DMatrix::from_fn(rows, 9, |r, j| f64::from(fixed[r] == j))],
             exact: Some(exact),
+            surd: None,
         };
         let names = ["K1", "K1·ax", "K1·ay", "K1·bx", "K1·by"]
             .into_iter()

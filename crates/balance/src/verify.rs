@@ -160,6 +160,7 @@ mod tests {
             }],
             unbalanced: TrigPoly::zero(),
             exact: Err("built by hand".into()),
+            surd: Err("built by hand".into()),
         }
     }
 

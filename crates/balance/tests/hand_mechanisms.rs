@@ -37,6 +37,7 @@ fn pendulum(mass: f64, com: f64) -> MechanismEnergy {
         bodies: frames,
         unbalanced,
         exact: Err("built by hand with numeric coefficients".to_string()),
+        surd: Err("built by hand with numeric coefficients".to_string()),
     }
 }
 
@@ -135,6 +136,7 @@ fn two_link(l1: f64, m1: f64, c1: f64, m2: f64, c2: f64) -> MechanismEnergy {
         bodies: frames,
         unbalanced,
         exact: Err("built by hand with numeric coefficients".to_string()),
+        surd: Err("built by hand with numeric coefficients".to_string()),
     }
 }
 

@@ -324,6 +324,7 @@ fn mechanism(arm: &Arm) -> MechanismEnergy {
         bodies,
         unbalanced,
         exact: Err("built by hand with numeric coefficients".to_string()),
+        surd: Err("built by hand with numeric coefficients".to_string()),
     }
 }
 

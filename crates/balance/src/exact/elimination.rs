@@ -15,24 +15,27 @@ use num_traits::{Signed, Zero};
 
 use counterpoise_symbolic::Rational;
 
+use super::field::ExactField;
+
 /// One solved row: `(pivot column, [(free column, coefficient)], value)`, meaning
 /// `x_pivot + Σ coefficient·x_free = value`.
-pub type Relation = (usize, Vec<(usize, Rational)>, Rational);
+pub type Relation<F = Rational> = (usize, Vec<(usize, F)>, F);
 
-/// The echelon form of `[A | r]` after Gauss–Jordan elimination.
+/// The echelon form of `[A | r]` after Gauss–Jordan elimination, over the field `F` (rows of
+/// integers over ℚ, of field elements otherwise).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Echelon {
+pub struct Echelon<F: ExactField = Rational> {
     /// Number of unknowns (columns of `A`).
     pub columns: usize,
     /// Non-zero rows: entries for columns `0..columns`, then the right-hand side.
-    rows: Vec<Vec<BigInt>>,
+    pub(super) rows: Vec<Vec<F::Entry>>,
     /// Pivot column of each row (strictly increasing).
     pub pivots: Vec<usize>,
     /// Whether `A x = r` has a solution (no row `0 = c ≠ 0`).
     pub consistent: bool,
 }
 
-impl Echelon {
+impl<F: ExactField> Echelon<F> {
     /// Rank of `A`.
     pub fn rank(&self) -> usize {
         self.pivots.len()
@@ -46,44 +49,40 @@ impl Echelon {
     }
 
     /// The solution with every free variable zero (only meaningful when consistent).
-    pub fn particular(&self) -> Vec<Rational> {
-        let mut x = vec![Rational::zero(); self.columns];
+    pub fn particular(&self) -> Vec<F> {
+        let mut x = vec![F::zero(); self.columns];
         for (row, &c) in self.rows.iter().zip(&self.pivots) {
-            x[c] = Rational::new(row[self.columns].clone(), row[c].clone());
+            x[c] = F::ratio(&row[self.columns], &row[c]);
         }
         x
     }
 
     /// Each row as `x_pivot + Σ coefficient·x_j = value` (coefficients of the free columns).
-    pub fn relations(&self) -> Vec<Relation> {
+    pub fn relations(&self) -> Vec<Relation<F>> {
         self.rows
             .iter()
             .zip(&self.pivots)
             .map(|(row, &p)| {
                 let terms = (0..self.columns)
-                    .filter(|&j| j != p && !Zero::is_zero(&row[j]))
-                    .map(|j| (j, Rational::new(row[j].clone(), row[p].clone())))
+                    .filter(|&j| j != p && !F::entry_is_zero(&row[j]))
+                    .map(|j| (j, F::ratio(&row[j], &row[p])))
                     .collect();
-                (
-                    p,
-                    terms,
-                    Rational::new(row[self.columns].clone(), row[p].clone()),
-                )
+                (p, terms, F::ratio(&row[self.columns], &row[p]))
             })
             .collect()
     }
 
     /// A basis of the null space of `A`: for each free column `f`, `x_f = 1`, other free
     /// variables zero, pivots solved.
-    pub fn nullspace(&self) -> Vec<Vec<Rational>> {
+    pub fn nullspace(&self) -> Vec<Vec<F>> {
         self.free_columns()
             .into_iter()
             .map(|f| {
-                let mut v = vec![Rational::zero(); self.columns];
-                v[f] = Rational::from_integer(BigInt::from(1));
+                let mut v = vec![F::zero(); self.columns];
+                v[f] = F::one();
                 for (row, &c) in self.rows.iter().zip(&self.pivots) {
-                    if !Zero::is_zero(&row[f]) {
-                        v[c] = Rational::new(-row[f].clone(), row[c].clone());
+                    if !F::entry_is_zero(&row[f]) {
+                        v[c] = F::ratio(&F::neg_entry(&row[f]), &row[c]);
                     }
                 }
                 v
@@ -167,7 +166,7 @@ impl Ring for BigInt {
 }
 
 /// Eliminates `[A | r]`, given as rows of `columns + 1` integers.
-pub fn eliminate(rows: &[Vec<BigInt>], columns: usize) -> Echelon {
+pub fn eliminate(rows: &[Vec<BigInt>], columns: usize) -> Echelon<Rational> {
     if let Some(echelon) = eliminate_small(rows, columns) {
         return echelon;
     }
@@ -176,7 +175,7 @@ pub fn eliminate(rows: &[Vec<BigInt>], columns: usize) -> Echelon {
 
 /// The elimination in checked `i128` alone: `None` when an entry does not fit or a step would
 /// overflow.
-fn eliminate_small(rows: &[Vec<BigInt>], columns: usize) -> Option<Echelon> {
+fn eliminate_small(rows: &[Vec<BigInt>], columns: usize) -> Option<Echelon<Rational>> {
     let small: Option<Vec<Vec<i128>>> = rows
         .iter()
         .map(|row| row.iter().map(|v| i128::try_from(v).ok()).collect())
@@ -207,7 +206,7 @@ fn remove_content<T: Ring>(row: &mut [T], pivot: Option<usize>) {
     }
 }
 
-fn gauss_jordan<T: Ring>(mut rows: Vec<Vec<T>>, columns: usize) -> Option<Echelon> {
+fn gauss_jordan<T: Ring>(mut rows: Vec<Vec<T>>, columns: usize) -> Option<Echelon<Rational>> {
     rows.retain(|row| row.iter().any(|v| !v.is_zero()));
     for row in &mut rows {
         remove_content(row, None);

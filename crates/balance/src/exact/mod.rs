@@ -15,38 +15,40 @@
 //! the projection of the positive family.
 
 pub mod elimination;
+pub mod elimination_field;
+pub mod field;
 pub mod positivity;
 pub mod rank_one;
 
 use std::collections::BTreeMap;
 
-use num_bigint::BigInt;
-use num_integer::Integer;
-use num_traits::{Signed, Zero};
-
 use counterpoise_model::ExactMechanism;
-use counterpoise_symbolic::{ExactPoly, Monomial, Rational};
+use counterpoise_symbolic::{Monomial, Poly, Rational, RefArith};
 
 use crate::element::{Attachment, Catalogue, Element, counterweight_energy, spring_energy};
-use elimination::{Echelon, eliminate};
+use elimination::Echelon;
+pub use field::ExactField;
 use positivity::Affine;
 
 /// The exact coefficient vectors of the unbalanced energy and of every catalogue element, on one
-/// shared list of monomials, each row scaled to coprime integers.
+/// shared list of monomials, each row scaled by a positive factor (to coprime integers over ℚ).
 #[derive(Clone, Debug)]
-pub struct ExactBasis {
+pub struct ExactBasis<F: ExactField = Rational> {
     /// Non-constant monomials that appear anywhere (the rows).
     pub monomials: Vec<Monomial>,
     /// Row-scaled coefficients of the unbalanced energy (`b`).
-    pub unbalanced: Vec<BigInt>,
+    pub unbalanced: Vec<F::Entry>,
     /// Per catalogue entry, per lifted variable: the row-scaled column.
-    pub elements: Vec<Vec<Vec<BigInt>>>,
-    /// The positive factor each row was scaled by (physical coefficient × factor = integer).
-    pub row_factors: Vec<Rational>,
+    pub elements: Vec<Vec<Vec<F::Entry>>>,
+    /// The positive factor each row was scaled by (physical coefficient × factor = entry).
+    pub row_factors: Vec<F>,
 }
 
 /// The exact energy polynomials of one catalogue entry, per lifted variable.
-pub fn element_polys(mechanism: &ExactMechanism, element: &Element) -> Vec<ExactPoly> {
+pub fn element_polys<F: ExactField>(
+    mechanism: &ExactMechanism<F>,
+    element: &Element,
+) -> Vec<Poly<F>> {
     match element {
         Element::Counterweight { body, axes } => {
             let frame = &mechanism.bodies[*body];
@@ -71,9 +73,12 @@ pub fn element_polys(mechanism: &ExactMechanism, element: &Element) -> Vec<Exact
     }
 }
 
-impl ExactBasis {
-    pub fn build(mechanism: &ExactMechanism, catalogue: &Catalogue) -> ExactBasis {
-        let polys: Vec<Vec<ExactPoly>> = catalogue
+impl<F: ExactField> ExactBasis<F>
+where
+    for<'a> &'a F: RefArith<F>,
+{
+    pub fn build(mechanism: &ExactMechanism<F>, catalogue: &Catalogue) -> ExactBasis<F> {
+        let polys: Vec<Vec<Poly<F>>> = catalogue
             .entries
             .iter()
             .map(|entry| element_polys(mechanism, &entry.element))
@@ -90,8 +95,8 @@ impl ExactBasis {
             *slot = row;
         }
         let rows = index.len();
-        let column = |poly: &ExactPoly| {
-            let mut v = vec![Rational::zero(); rows];
+        let column = |poly: &Poly<F>| {
+            let mut v = vec![F::zero(); rows];
             for (m, c) in poly.terms_ref() {
                 if let Some(&row) = index.get(m) {
                     v[row] = c.clone();
@@ -100,79 +105,52 @@ impl ExactBasis {
             v
         };
         let b = column(&mechanism.unbalanced);
-        let columns: Vec<Vec<Vec<Rational>>> = polys
+        let columns: Vec<Vec<Vec<F>>> = polys
             .iter()
             .map(|entry| entry.iter().map(&column).collect())
             .collect();
-        // One positive factor per row: the lcm of its denominators over the gcd of its
-        // numerators.
-        let mut factors = Vec::with_capacity(rows);
-        for r in 0..rows {
-            let entries = std::iter::once(&b[r]).chain(columns.iter().flatten().map(|c| &c[r]));
-            let (mut lcm, mut gcd) = (BigInt::from(1), BigInt::zero());
-            for q in entries.filter(|q| !q.is_zero()) {
-                lcm = lcm.lcm(q.denom());
-                gcd = gcd.gcd(q.numer());
-            }
-            let gcd = if gcd.is_zero() { BigInt::from(1) } else { gcd };
-            factors.push(Rational::new(lcm, gcd));
-        }
-        let scale = |v: &[Rational]| -> Vec<BigInt> {
-            v.iter()
-                .zip(&factors)
-                .map(|(q, f)| {
-                    let s = q * f;
-                    debug_assert!(s.is_integer());
-                    s.to_integer()
-                })
-                .collect()
-        };
+        let (unbalanced, elements, row_factors) = F::scale_rows(b, columns);
         ExactBasis {
             monomials: index.into_keys().collect(),
-            unbalanced: scale(&b),
-            elements: columns
-                .iter()
-                .map(|entry| entry.iter().map(|c| scale(c)).collect())
-                .collect(),
-            row_factors: factors,
+            unbalanced,
+            elements,
+            row_factors,
         }
     }
 
     /// Eliminates variant `elements` exactly.
-    pub fn solve(&self, elements: &[usize]) -> ExactSolution {
+    pub fn solve(&self, elements: &[usize]) -> ExactSolution<F> {
         self.solve_with(elements, &[])
     }
 
     /// Eliminates variant `elements` exactly with extra homogeneous equations `e·x = 0` (rows
     /// over the variant's lifted variables), e.g. a spring's `W = a₀ βᵀ` once its anchor is known.
-    pub fn solve_with(&self, elements: &[usize], extra: &[Vec<Rational>]) -> ExactSolution {
+    pub fn solve_with(&self, elements: &[usize], extra: &[Vec<F>]) -> ExactSolution<F> {
         let mut offsets = Vec::with_capacity(elements.len() + 1);
-        let mut columns: Vec<&Vec<BigInt>> = Vec::new();
+        let mut columns: Vec<&Vec<F::Entry>> = Vec::new();
         for &e in elements {
             offsets.push(columns.len());
             columns.extend(&self.elements[e]);
         }
         offsets.push(columns.len());
         let n = columns.len();
-        let rows: Vec<Vec<BigInt>> = (0..self.monomials.len())
-            .filter(|&r| !self.unbalanced[r].is_zero() || columns.iter().any(|c| !c[r].is_zero()))
+        let mut rows: Vec<Vec<F::Entry>> = (0..self.monomials.len())
+            .filter(|&r| {
+                !F::entry_is_zero(&self.unbalanced[r])
+                    || columns.iter().any(|c| !F::entry_is_zero(&c[r]))
+            })
             .map(|r| {
-                let mut row: Vec<BigInt> = columns.iter().map(|c| c[r].clone()).collect();
-                row.push(-self.unbalanced[r].clone());
+                let mut row: Vec<F::Entry> = columns.iter().map(|c| c[r].clone()).collect();
+                row.push(F::neg_entry(&self.unbalanced[r]));
                 row
             })
             .collect();
-        let mut rows = rows;
         for e in extra {
-            let lcm = e.iter().fold(BigInt::from(1), |acc, q| acc.lcm(q.denom()));
-            let mut row: Vec<BigInt> = e
-                .iter()
-                .map(|q| (q * Rational::from_integer(lcm.clone())).to_integer())
-                .collect();
-            row.push(BigInt::zero());
+            let mut row = F::equation_row(e);
+            row.push(F::zero_entry());
             rows.push(row);
         }
-        let echelon = eliminate(&rows, n);
+        let echelon = F::eliminate(rows, n);
         let (particular, nullspace) = if echelon.consistent {
             (echelon.particular(), echelon.nullspace())
         } else {
@@ -190,19 +168,22 @@ impl ExactBasis {
 
 /// One variant's exact solution set `x_p + N z`, or the fact that it is empty.
 #[derive(Clone, Debug)]
-pub struct ExactSolution {
+pub struct ExactSolution<F: ExactField = Rational> {
     /// Catalogue entries of the variant.
     pub elements: Vec<usize>,
     /// Start of each element's variables in `x`, plus the total at the end.
     pub offsets: Vec<usize>,
-    pub echelon: Echelon,
+    pub echelon: Echelon<F>,
     /// Particular solution (free variables zero); empty when inconsistent.
-    pub particular: Vec<Rational>,
+    pub particular: Vec<F>,
     /// Basis of the free directions; empty when inconsistent.
-    pub nullspace: Vec<Vec<Rational>>,
+    pub nullspace: Vec<Vec<F>>,
 }
 
-impl ExactSolution {
+impl<F: ExactField> ExactSolution<F>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     pub fn consistent(&self) -> bool {
         self.echelon.consistent
     }
@@ -226,7 +207,7 @@ impl ExactSolution {
     }
 
     /// Variable `j` as an affine function of the free parameters `z`.
-    pub fn affine(&self, j: usize) -> Affine {
+    pub fn affine(&self, j: usize) -> Affine<F> {
         Affine {
             constant: self.particular[j].clone(),
             coefficients: self.nullspace.iter().map(|v| v[j].clone()).collect(),
@@ -234,15 +215,15 @@ impl ExactSolution {
     }
 
     /// Whether element `k`'s energy contribution `A_k x_k` is zero in every solution.
-    pub fn contribution_forced_zero(&self, basis: &ExactBasis, k: usize) -> bool {
+    pub fn contribution_forced_zero(&self, basis: &ExactBasis<F>, k: usize) -> bool {
         let columns = &basis.elements[self.elements[k]];
         let range = self.element_range(k);
-        let vanishes = |x: &[Rational]| {
+        let vanishes = |x: &[F]| {
             (0..basis.monomials.len()).all(|r| {
-                let mut sum = Rational::zero();
+                let mut sum = F::zero();
                 for (c, j) in columns.iter().zip(range.clone()) {
-                    if !c[r].is_zero() && !x[j].is_zero() {
-                        sum += &x[j] * Rational::from_integer(c[r].clone());
+                    if !F::entry_is_zero(&c[r]) && !x[j].is_zero() {
+                        sum += &x[j] * F::entry_value(&c[r]);
                     }
                 }
                 sum.is_zero()
@@ -257,7 +238,7 @@ impl ExactSolution {
         &self,
         stiffness: usize,
         range: std::ops::Range<usize>,
-    ) -> Option<Vec<Rational>> {
+    ) -> Option<Vec<F>> {
         let k = self.affine(stiffness);
         let pivot = k.coefficients.iter().position(|c| !c.is_zero());
         range
@@ -279,7 +260,7 @@ impl ExactSolution {
     }
 
     /// Heads (masses and stiffnesses) of the variant's elements as affine functions of `z`.
-    pub fn heads(&self) -> Vec<Affine> {
+    pub fn heads(&self) -> Vec<Affine<F>> {
         (0..self.elements.len())
             .map(|k| self.affine(self.offsets[k]))
             .collect()
@@ -291,9 +272,15 @@ impl ExactSolution {
     }
 }
 
-/// Writes a rational exactly, with its decimal value beside it when it is not an integer:
-/// `1829/8 (228.625)`.
-pub fn exact_text(q: &Rational) -> String {
+/// Writes an exact number, with its decimal value beside it when it is not an integer:
+/// `1829/8 (228.625)`, `1/2√3 (0.866025)`.
+pub fn exact_text<F: ExactField>(x: &F) -> String {
+    let Some(q) = x.rational() else {
+        return format!(
+            "{x} ({})",
+            crate::relations::significant(counterpoise_symbolic::Scalar::to_f64(x))
+        );
+    };
     if q.is_integer() {
         format!("{}", q.numer())
     } else {
@@ -301,7 +288,7 @@ pub fn exact_text(q: &Rational) -> String {
             "{}/{} ({})",
             q.numer(),
             q.denom(),
-            crate::relations::significant(counterpoise_symbolic::rational_to_f64(q))
+            crate::relations::significant(counterpoise_symbolic::rational_to_f64(&q))
         )
     }
 }
@@ -309,6 +296,7 @@ pub fn exact_text(q: &Rational) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use num_bigint::BigInt;
 
     fn ints(v: &[i64]) -> Vec<BigInt> {
         v.iter().map(|&x| BigInt::from(x)).collect()

@@ -8,19 +8,22 @@
 //! inequality: when it ends in `0 < c ≤ 0`, those multipliers are a Farkas certificate,
 //! `Σ λ_i h_i(z) ≡ c ≤ 0`, that anyone can check by hand.
 
-use num_traits::{Signed, Zero};
+use counterpoise_symbolic::{Rational, RefArith};
 
-use counterpoise_symbolic::Rational;
+use super::field::ExactField;
 
 /// An affine function `constant + Σ coefficients[k]·z_k`.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Affine {
-    pub constant: Rational,
-    pub coefficients: Vec<Rational>,
+pub struct Affine<F = Rational> {
+    pub constant: F,
+    pub coefficients: Vec<F>,
 }
 
-impl Affine {
-    fn combine(&self, a: &Rational, other: &Affine, b: &Rational) -> Affine {
+impl<F: ExactField> Affine<F>
+where
+    for<'a> &'a F: RefArith<F>,
+{
+    fn combine(&self, a: &F, other: &Affine<F>, b: &F) -> Affine<F> {
         Affine {
             constant: &self.constant * a + &other.constant * b,
             coefficients: self
@@ -33,29 +36,35 @@ impl Affine {
     }
 
     pub fn is_constant(&self) -> bool {
-        self.coefficients.iter().all(Zero::is_zero)
+        self.coefficients.iter().all(|c| c.is_zero())
     }
 }
 
 /// `f(z) > 0` (strict) or `f(z) ≥ 0`, with the multipliers of the original constraints that
 /// produced it.
 #[derive(Clone, Debug)]
-struct Inequality {
-    f: Affine,
+struct Inequality<F> {
+    f: Affine<F>,
     strict: bool,
-    multipliers: Vec<Rational>,
+    multipliers: Vec<F>,
 }
 
 /// Why no `z` satisfies the constraints: `Σ multipliers[i]·h_i(z) ≡ value` for every `z`, with
 /// non-negative multipliers, while the constraints demand it be positive.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Infeasibility {
-    pub multipliers: Vec<Rational>,
-    pub value: Rational,
+pub struct Infeasibility<F = Rational> {
+    pub multipliers: Vec<F>,
+    pub value: F,
 }
 
 /// Eliminates every variable but the last `keep` ones; `Err` on a contradiction.
-fn eliminate(mut rows: Vec<Inequality>, keep: usize) -> Result<Vec<Inequality>, Infeasibility> {
+fn eliminate<F: ExactField>(
+    mut rows: Vec<Inequality<F>>,
+    keep: usize,
+) -> Result<Vec<Inequality<F>>, Infeasibility<F>>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     let n = rows.first().map_or(0, |r| r.f.coefficients.len());
     for var in 0..n.saturating_sub(keep) {
         let (mut positive, mut negative, mut rest) = (Vec::new(), Vec::new(), Vec::new());
@@ -93,7 +102,10 @@ fn eliminate(mut rows: Vec<Inequality>, keep: usize) -> Result<Vec<Inequality>, 
 }
 
 /// A row without variables must hold as it stands.
-fn check_constants(rows: &[Inequality]) -> Result<(), Infeasibility> {
+fn check_constants<F: ExactField>(rows: &[Inequality<F>]) -> Result<(), Infeasibility<F>>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     for row in rows.iter().filter(|r| r.f.is_constant()) {
         let c = &row.f.constant;
         let violated = if row.strict {
@@ -111,7 +123,7 @@ fn check_constants(rows: &[Inequality]) -> Result<(), Infeasibility> {
     Ok(())
 }
 
-fn strict_rows(constraints: &[Affine]) -> Vec<Inequality> {
+fn strict_rows<F: ExactField>(constraints: &[Affine<F>]) -> Vec<Inequality<F>> {
     let m = constraints.len();
     constraints
         .iter()
@@ -120,20 +132,17 @@ fn strict_rows(constraints: &[Affine]) -> Vec<Inequality> {
             f: f.clone(),
             strict: true,
             multipliers: (0..m)
-                .map(|j| {
-                    if i == j {
-                        Rational::from_integer(1.into())
-                    } else {
-                        Rational::zero()
-                    }
-                })
+                .map(|j| if i == j { F::one() } else { F::zero() })
                 .collect(),
         })
         .collect()
 }
 
 /// Whether some `z` makes every constraint strictly positive; the certificate when none does.
-pub fn strictly_feasible(constraints: &[Affine]) -> Result<(), Infeasibility> {
+pub fn strictly_feasible<F: ExactField>(constraints: &[Affine<F>]) -> Result<(), Infeasibility<F>>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     let rows = strict_rows(constraints);
     check_constants(&rows)?;
     eliminate(rows, 0).map(|_| ())
@@ -141,21 +150,27 @@ pub fn strictly_feasible(constraints: &[Affine]) -> Result<(), Infeasibility> {
 
 /// One end of an interval: `None` for ±∞.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Bound {
-    pub value: Rational,
+pub struct Bound<F = Rational> {
+    pub value: F,
     /// Whether the end is attained.
     pub closed: bool,
 }
 
 /// The range of an affine function over `{z : every constraint > 0}` (assumed non-empty).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Range {
-    pub low: Option<Bound>,
-    pub high: Option<Bound>,
+pub struct Range<F = Rational> {
+    pub low: Option<Bound<F>>,
+    pub high: Option<Bound<F>>,
 }
 
 /// The range of `target(z)` while every constraint is strictly positive.
-pub fn range(constraints: &[Affine], target: &Affine) -> Result<Range, Infeasibility> {
+pub fn range<F: ExactField>(
+    constraints: &[Affine<F>],
+    target: &Affine<F>,
+) -> Result<Range<F>, Infeasibility<F>>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     let Some(pivot) = target.coefficients.iter().position(|c| !c.is_zero()) else {
         strictly_feasible(constraints)?;
         let fixed = Bound {
@@ -170,9 +185,9 @@ pub fn range(constraints: &[Affine], target: &Affine) -> Result<Range, Infeasibi
     // z_pivot = (t − target.constant − Σ_{k≠pivot} g_k z_k) / g_pivot; the variables become
     // (z without pivot, t), t last.
     let g = &target.coefficients;
-    let substitute = |f: &Affine| -> Affine {
+    let substitute = |f: &Affine<F>| -> Affine<F> {
         let ratio = &f.coefficients[pivot] / &g[pivot];
-        let mut coefficients: Vec<Rational> = f
+        let mut coefficients: Vec<F> = f
             .coefficients
             .iter()
             .zip(g)
@@ -186,19 +201,14 @@ pub fn range(constraints: &[Affine], target: &Affine) -> Result<Range, Infeasibi
             coefficients,
         }
     };
-    let transformed: Vec<Affine> = constraints.iter().map(substitute).collect();
+    let transformed: Vec<Affine<F>> = constraints.iter().map(substitute).collect();
     let rows = strict_rows(&transformed);
     check_constants(&rows)?;
     let rows = eliminate(rows, 1)?;
-    let mut low: Option<Bound> = None;
-    let mut high: Option<Bound> = None;
+    let mut low: Option<Bound<F>> = None;
+    let mut high: Option<Bound<F>> = None;
     for row in rows {
-        let a = row
-            .f
-            .coefficients
-            .last()
-            .cloned()
-            .unwrap_or_else(Rational::zero);
+        let a = row.f.coefficients.last().cloned().unwrap_or_else(F::zero);
         if a.is_zero() {
             continue; // checked as a constant row by the elimination
         }

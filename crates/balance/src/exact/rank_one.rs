@@ -7,32 +7,33 @@
 //! `K = −c₀/c₁`; if that value is not a positive stiffness the whole family admits (or two rows
 //! demand different values, or `c₁ = 0 ≠ c₀`), no spring does: a proof, not a threshold.
 
-use num_traits::{Signed, Zero};
-
-use counterpoise_symbolic::Rational;
+use counterpoise_symbolic::RefArith;
 
 use super::positivity::{self, Affine};
-use super::{ExactBasis, ExactSolution, exact_text};
+use super::{ExactBasis, ExactField, ExactSolution, exact_text};
 use crate::element::{CatalogueEntry, Element};
 
 /// A quadratic polynomial in `z`: constant, linear and (unsymmetrised) quadratic coefficients.
-struct Quadratic {
-    constant: Rational,
-    linear: Vec<Rational>,
-    quadratic: Vec<Vec<Rational>>,
+struct Quadratic<F> {
+    constant: F,
+    linear: Vec<F>,
+    quadratic: Vec<Vec<F>>,
 }
 
-impl Quadratic {
-    fn zero(n: usize) -> Quadratic {
+impl<F: ExactField> Quadratic<F>
+where
+    for<'a> &'a F: RefArith<F>,
+{
+    fn zero(n: usize) -> Quadratic<F> {
         Quadratic {
-            constant: Rational::zero(),
-            linear: vec![Rational::zero(); n],
-            quadratic: vec![vec![Rational::zero(); n]; n],
+            constant: F::zero(),
+            linear: vec![F::zero(); n],
+            quadratic: vec![vec![F::zero(); n]; n],
         }
     }
 
     /// `self += s · f · g`.
-    fn add_product(&mut self, s: &Rational, f: &Affine, g: &Affine) {
+    fn add_product(&mut self, s: &F, f: &Affine<F>, g: &Affine<F>) {
         if s.is_zero() {
             return;
         }
@@ -62,24 +63,27 @@ impl Quadratic {
 }
 
 /// What one residual row demands of the stiffness.
-enum Demand {
+enum Demand<F> {
     /// Not of the form `c₀ + c₁ K`: this test says nothing.
     Unknown,
     /// Zero everywhere: no condition.
     Nothing,
     /// `c₀ + c₁·K` with `c₁ = 0 ≠ c₀`: never zero.
-    Impossible(Rational),
+    Impossible(F),
     /// `c₀ + c₁·K` with `c₁ ≠ 0`: zero exactly at `K = −c₀/c₁`.
-    Stiffness { c0: Rational, c1: Rational },
+    Stiffness { c0: F, c1: F },
 }
 
-fn demand(residual: &Quadratic, stiffness: &Affine) -> Demand {
+fn demand<F: ExactField>(residual: &Quadratic<F>, stiffness: &Affine<F>) -> Demand<F>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     if residual.has_quadratic_part() {
         return Demand::Unknown;
     }
     let c1 = match stiffness.coefficients.iter().position(|c| !c.is_zero()) {
         Some(u) => &residual.linear[u] / &stiffness.coefficients[u],
-        None => Rational::zero(),
+        None => F::zero(),
     };
     let parallel = residual
         .linear
@@ -98,11 +102,14 @@ fn demand(residual: &Quadratic, stiffness: &Affine) -> Demand {
 }
 
 /// The proof that some spring of the variant cannot be rank-one, when this test finds one.
-pub fn contradiction(
-    basis: &ExactBasis,
-    solution: &ExactSolution,
+pub fn contradiction<F: ExactField>(
+    basis: &ExactBasis<F>,
+    solution: &ExactSolution<F>,
     entries: &[&CatalogueEntry],
-) -> Option<String> {
+) -> Option<String>
+where
+    for<'a> &'a F: RefArith<F>,
+{
     let heads = solution.heads();
     let n = solution.nullity();
     for (k, entry) in entries.iter().enumerate() {
@@ -114,13 +121,13 @@ pub fn contradiction(
         let w_start = start + 1 + na + nb;
         let columns = &basis.elements[solution.elements[k]];
         let stiffness = solution.affine(start);
-        let mut required: Option<Rational> = None;
+        let mut required: Option<F> = None;
         let mut form = String::new();
         for (r, factor) in basis.row_factors.iter().enumerate() {
-            let weights: Vec<Rational> = (0..na * nb)
-                .map(|ij| Rational::from_integer(columns[1 + na + nb + ij][r].clone()))
+            let weights: Vec<F> = (0..na * nb)
+                .map(|ij| F::entry_value(&columns[1 + na + nb + ij][r]))
                 .collect();
-            if weights.iter().all(Zero::is_zero) {
+            if weights.iter().all(|w| w.is_zero()) {
                 continue;
             }
             let mut residual = Quadratic::zero(n);
@@ -205,7 +212,7 @@ pub fn contradiction(
 mod tests {
     use super::*;
     use crate::element::Attachment;
-    use counterpoise_symbolic::Monomial;
+    use counterpoise_symbolic::{Monomial, Rational};
     use num_bigint::BigInt;
 
     fn spring() -> CatalogueEntry {
