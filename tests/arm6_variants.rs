@@ -115,3 +115,52 @@ fn the_minimal_guard_estimates_the_pruned_walk() {
         stderr(&refused)
     );
 }
+
+/// `run` on the arm at Dmax 2 (nothing balances: 25 unrealizable, 2 undecided, 351 infeasible)
+/// states the smallest Dmax at which a variant balances — 3, as the full Dmax 3 search of
+/// `arm6_variants_at_dmax_3_finish_without_a_panic` and the minimal sets above find — and
+/// writes the partial balancing with at most 2 counterweights: C(6, 1) + C(6, 2) = 21 sets,
+/// ranked as `partial --budget 2` ranks them (the same best design and residual).
+#[test]
+fn run_on_the_arm_states_the_smallest_dmax_and_the_best_partial_designs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    let out = counterpoise(&[
+        "run",
+        "cases/arm6.json",
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_success(&out);
+    // The summary is wrapped at 120 columns: compare word by word.
+    let text = common::stdout(&out)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    assert!(text.contains("No feasible balanced variant."), "{text}");
+    assert!(
+        text.contains("the smallest Dmax at which one does is 3, e.g. m2 + m3 + m5"),
+        "{text}"
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("partial.json")).unwrap())
+            .unwrap();
+    assert_eq!(doc["smallest_dmax"]["smallest_balanced"], 3);
+    assert_eq!(doc["sets"], 21);
+    let csv = std::fs::read_to_string(out_dir.join("partial.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 22);
+    let alone = counterpoise(&["partial", "cases/arm6.json", "--budget", "2", "--json"]);
+    assert_success(&alone);
+    let alone: serde_json::Value = serde_json::from_slice(&alone.stdout).unwrap();
+    assert_eq!(doc["designs"][0]["labels"], serde_json::json!(["m2", "m3"]));
+    assert_eq!(doc["designs"][0]["labels"], alone["designs"][0]["labels"]);
+    let (a, b) = (
+        doc["designs"][0]["total_rms"].as_f64().unwrap(),
+        alone["designs"][0]["total_rms"].as_f64().unwrap(),
+    );
+    assert!((a - b).abs() <= 1e-9 * b, "{a} against {b}");
+    // Two counterweights remove most of the torque (README: about 94 %).
+    let unbalanced = doc["unbalanced_total"].as_f64().unwrap();
+    assert!(a < 0.1 * unbalanced, "{a} of {unbalanced}");
+}

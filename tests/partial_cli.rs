@@ -4,7 +4,7 @@
 mod common;
 
 use common::{assert_success, case_json, counterpoise, stderr, stdout, write_case};
-use serde_json::{Value, json};
+use serde_json::{json, Value};
 
 const G: f64 = 9.81;
 
@@ -185,4 +185,98 @@ fn variants_points_to_partial_when_nothing_balances() {
     let out = counterpoise(&["variants", "cases/pendulum.json", "--dmax", "1"]);
     assert_success(&out);
     assert!(!stdout(&out).contains(hint), "{}", stdout(&out));
+}
+
+/// `run` when no variant is feasible: the pendulum (`τ = 9.81 cos θ`, `m·r = (−1, 0)` balances
+/// it) with `m ≤ 2 kg`, `|r| ≤ 0.25 m` and `K ≤ 1 N/m` cannot be balanced within its bounds,
+/// so `run` adds the partial balancing at Dmax 1: the closed form of
+/// `pendulum_matches_the_closed_form` (half the torque, 2 kg at 0.25 m), but over the run's
+/// 5-value task grid widened to the default 7 workspace values. With the case's own (derived)
+/// bounds a variant is feasible and no partial file is written.
+#[test]
+fn run_adds_the_partial_balancing_when_no_variant_is_feasible() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = case_json("pendulum.json");
+    case["balancing"]["bounds"] =
+        json!({ "mass": [0, 2], "radius": [0, 0.25], "stiffness": [0, 1] });
+    let path = write_case(dir.path(), "pendulum.json", &case);
+    let out_dir = dir.path().join("out");
+    let out = counterpoise(&["run", &path, "--out", out_dir.to_str().unwrap(), "--quiet"]);
+    assert_success(&out);
+    // The summary is wrapped at 120 columns: compare word by word.
+    let text = stdout(&out)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let thetas: Vec<f64> = (0..7).map(|i| -1.5 + 0.5 * i as f64).collect();
+    let unbalanced = G * (thetas.iter().map(|t| t.cos().powi(2)).sum::<f64>() / 7.0).sqrt();
+    // Both variants (m1, K10) balance exactly but not within the bounds.
+    assert!(
+        text.contains(
+            "No feasible variant at Dmax 1: 2 variants of at most 1 element balance exactly"
+        ),
+        "{text}"
+    );
+    assert!(
+        text.contains(&format!(
+            "m1: total {:.3} (-50.0 %; M1 -50.0 %)",
+            0.5 * unbalanced
+        )),
+        "{text}"
+    );
+    assert!(text.contains("partial.json"), "{text}");
+    let doc: Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("partial.json")).unwrap())
+            .unwrap();
+    assert!(
+        close(f(&doc["unbalanced_total"]), unbalanced, 1e-9),
+        "{doc}"
+    );
+    let best = &doc["designs"][0];
+    assert!(
+        close(f(&best["total_rms"]), 0.5 * unbalanced, 1e-6),
+        "{best}"
+    );
+    assert!(
+        close(f(&best["counterweights"][0]["mass"]), 2.0, 1e-5),
+        "{best}"
+    );
+    assert_eq!(doc["smallest_dmax"]["smallest_balanced"], 1);
+    // One counterweight: one set, one CSV row under the header.
+    let csv = std::fs::read_to_string(out_dir.join("partial.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 2, "{csv}");
+    assert!(
+        csv.lines().nth(1).unwrap().starts_with("1,\"m1\",1,"),
+        "{csv}"
+    );
+    // The note reaches results.json and the reports.
+    let results: Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap())
+            .unwrap();
+    let notes = results["metadata"]["notes"].as_array().unwrap();
+    assert!(
+        notes.iter().any(|n| n
+            .as_str()
+            .unwrap()
+            .starts_with("No feasible variant at Dmax 1")),
+        "{notes:?}"
+    );
+    let html = std::fs::read_to_string(out_dir.join("report.html")).unwrap();
+    assert!(html.contains("No feasible variant at Dmax 1"));
+
+    let feasible_dir = dir.path().join("feasible");
+    let out = counterpoise(&[
+        "run",
+        "cases/pendulum.json",
+        "--out",
+        feasible_dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_success(&out);
+    assert!(
+        !stdout(&out).contains("No feasible variant at Dmax"),
+        "{}",
+        stdout(&out)
+    );
+    assert!(!feasible_dir.join("partial.json").exists());
 }

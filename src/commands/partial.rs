@@ -3,22 +3,24 @@
 //! RMS gravity torque over the workspace on the joints that matter, ranked, each beside the
 //! exact balance search's verdict on the same set.
 
+pub mod fallback;
+
 use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::{bail, Result};
 use counterpoise_balance::linear::LiftedBasis;
 use counterpoise_balance::partial::{
-    CounterweightLimits, PartialDesign, PartialOptions, PartialReport, TorqueBasis, Workspace,
-    counterweight_entries, partial_search, set_count,
+    counterweight_entries, partial_search, set_count, CounterweightLimits, PartialDesign,
+    PartialOptions, PartialReport, TorqueBasis, Workspace,
 };
 use counterpoise_balance::search::decide;
 use counterpoise_balance::{
-    Catalogue, Status, VerificationSet, catalogue_options, mechanism_energy, realization_hints,
+    catalogue_options, mechanism_energy, realization_hints, Catalogue, Status, VerificationSet,
 };
 use counterpoise_dynamics::Evaluator;
-use counterpoise_model::limits::{Limit, format_count};
+use counterpoise_model::limits::{format_count, Limit};
 use counterpoise_model::{Model, ModelError};
 use counterpoise_optimise::{BoundsTable, ElementBounds};
 use serde_json::json;
@@ -164,22 +166,38 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     if budget == 0 {
         bail!("--budget must be at least 1");
     }
-    let started = Instant::now();
     let joints = select_joints(&model, options.joints.as_deref())?;
     let energy = mechanism_energy(&model);
     let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
-    let candidates = counterweight_entries(&catalogue);
-    if candidates.is_empty() {
+    if counterweight_entries(&catalogue).is_empty() {
         bail!(
             "{}: `balancing` allows no counterweight (partial balancing covers counterweights \
              only)",
             path.display()
         );
     }
-    let sets = set_count(&catalogue, budget);
+    if let Err(e) = set_guard(&catalogue, budget) {
+        super::print_errors(path, &super::located(path, vec![e]));
+        return Ok(ExitCode::FAILURE);
+    }
+    let computed = compute(&model, budget, joints, options.points, options.top)?;
+    if options.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&to_json(&model, &computed))?
+        );
+    } else {
+        print!("{}", tables(&model, &computed));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The variant limit applied to the number of sets the search solves.
+fn set_guard(catalogue: &Catalogue, budget: usize) -> Result<(), ModelError> {
+    let sets = set_count(catalogue, budget);
     let limit = counterpoise::preflight::limits().get(Limit::Variants);
     if sets > u128::from(limit) {
-        let e = ModelError::Invalid {
+        return Err(ModelError::Invalid {
             path: "--budget".into(),
             reason: format!(
                 "{} sets of at most {budget} counterweights; the limit is {}; lower --budget, or {}",
@@ -187,13 +205,40 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
                 format_count(limit as f64),
                 Limit::Variants.hint()
             ),
-        };
-        super::print_errors(path, &super::located(path, vec![e]));
-        return Ok(ExitCode::FAILURE);
+        });
     }
-    let bounds = limits(&model, &catalogue)?;
-    let (targets, per_axis) = workspace_points(&model, options.points)?;
-    let evaluator = Evaluator::new(&model)?;
+    Ok(())
+}
+
+/// A partial search with what its tables need: the ranking, the workspace it was measured on,
+/// the designs shown and the exact search's verdict on each.
+pub struct Computed {
+    pub report: PartialReport,
+    sample: Sample,
+    /// Indices into `report.designs` of the designs shown (see [`shown`]).
+    pub shown: Vec<usize>,
+    /// The exact balance search's verdict on each shown set.
+    pub verdicts: Vec<Status>,
+    pub seconds: f64,
+}
+
+/// Solves every set of at most `budget` counterweights of the case for the least RMS gravity
+/// torque on `joints` (actuator indices) over the workspace sample (`points` values per varying
+/// actuator), and decides the `top` best sets of each size exactly.
+pub fn compute(
+    model: &Model,
+    budget: usize,
+    joints: Vec<usize>,
+    points: Option<usize>,
+    top: usize,
+) -> Result<Computed> {
+    let started = Instant::now();
+    let energy = mechanism_energy(model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
+    let candidates = counterweight_entries(&catalogue);
+    let bounds = limits(model, &catalogue)?;
+    let (targets, per_axis) = workspace_points(model, points)?;
+    let evaluator = Evaluator::new(model)?;
     let mut configurations = Vec::with_capacity(targets.len());
     let mut unreachable = 0;
     for u in &targets {
@@ -202,11 +247,10 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
             Err(_) => unreachable += 1,
         }
     }
-    let workspace = Workspace::new(&model, &configurations);
+    let workspace = Workspace::new(model, &configurations);
     if workspace.is_empty() {
         bail!(
-            "{}: none of the {} workspace points is reachable with a regular actuator Jacobian",
-            path.display(),
+            "none of the {} workspace points is reachable with a regular actuator Jacobian",
             targets.len()
         );
     }
@@ -218,10 +262,10 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
         &PartialOptions::new(budget, joints),
     )?;
     // The exact verdict of the sets shown: does the set balance at all, whatever the bounds?
-    let shown = shown(&report, options.top);
+    let shown = shown(&report, top);
     let lifted = LiftedBasis::build(&energy, &catalogue);
     let checks = VerificationSet::new(&energy);
-    let hints = realization_hints(&model);
+    let hints = realization_hints(model);
     let verdicts: Vec<Status> = shown
         .iter()
         .map(|&i| {
@@ -236,23 +280,18 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
             .status
         })
         .collect();
-    let seconds = started.elapsed().as_secs_f64();
-    let sample = Sample {
-        requested: targets.len(),
-        per_axis,
-        unreachable,
-        singular: workspace.singular,
-    };
-    if options.json {
-        let doc = to_json(&model, &report, &sample, &shown, &verdicts, seconds);
-        println!("{}", serde_json::to_string_pretty(&doc)?);
-    } else {
-        print!(
-            "{}",
-            tables(&model, &report, &sample, &shown, &verdicts, seconds)
-        );
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(Computed {
+        report,
+        sample: Sample {
+            requested: targets.len(),
+            per_axis,
+            unreachable,
+            singular: workspace.singular,
+        },
+        shown,
+        verdicts,
+        seconds: started.elapsed().as_secs_f64(),
+    })
 }
 
 /// How the workspace was sampled.
@@ -318,14 +357,14 @@ fn model_label(d: &PartialDesign, entry: usize) -> String {
         .map_or_else(|| "?".into(), |i| d.labels[i].clone())
 }
 
-fn tables(
-    model: &Model,
-    report: &PartialReport,
-    sample: &Sample,
-    shown: &[usize],
-    verdicts: &[Status],
-    seconds: f64,
-) -> String {
+fn tables(model: &Model, computed: &Computed) -> String {
+    let Computed {
+        report,
+        sample,
+        shown,
+        verdicts,
+        seconds,
+    } = computed;
     let names: Vec<&str> = model.actuators.iter().map(|a| a.name.as_str()).collect();
     let selected: Vec<&str> = report.joints.iter().map(|&j| names[j]).collect();
     let mut out = format!(
@@ -398,14 +437,15 @@ fn tables(
     out
 }
 
-fn to_json(
-    model: &Model,
-    report: &PartialReport,
-    sample: &Sample,
-    shown: &[usize],
-    verdicts: &[Status],
-    seconds: f64,
-) -> serde_json::Value {
+/// The `partial --json` document (also `run`'s partial.json).
+pub fn to_json(model: &Model, computed: &Computed) -> serde_json::Value {
+    let Computed {
+        report,
+        sample,
+        shown,
+        verdicts,
+        seconds,
+    } = computed;
     let names: Vec<&str> = model.actuators.iter().map(|a| a.name.as_str()).collect();
     let exact: Vec<serde_json::Value> = shown
         .iter()

@@ -10,18 +10,18 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
-use anyhow::{Context as _, Result, bail};
+use anyhow::{bail, Context as _, Result};
 use counterpoise::shard::{self, ShardSpec};
 use counterpoise_balance::{
-    Catalogue, SearchOptions, SearchReport, Status, VariantResult, catalogue_options,
-    mechanism_energy, realization_hints, search,
+    catalogue_options, mechanism_energy, realization_hints, search, Catalogue, SearchOptions,
+    SearchReport, Status, VariantResult,
 };
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{
-    Counterweight, EvaluateOptions, Indicators, Spring, Variant, evaluate_grid, task_series_with,
+    evaluate_grid, task_series_with, Counterweight, EvaluateOptions, Indicators, Spring, Variant,
 };
 use counterpoise_model::Model;
-use counterpoise_optimise::{Context, Objective, OptimiseOptions, optimise_all_reporting};
+use counterpoise_optimise::{optimise_all_reporting, Context, Objective, OptimiseOptions};
 use counterpoise_report as report;
 use report::{
     ActuatorSummary, ElementInfo, ElementKind, Evaluation, FreeDirection, JointPeak, OptimiserInfo,
@@ -444,9 +444,37 @@ pub fn finish(
         results.energy = super::design::energy_chart(model, &results)?;
         Ok(())
     })?;
+    // Nothing to recommend: how many elements the mechanism needs, and the best partial
+    // balancing within Dmax (partial.json, partial.csv, a note the reports print).
+    let fallback = if results
+        .variants
+        .iter()
+        .any(|v| v.status == VariantStatus::Feasible)
+    {
+        None
+    } else {
+        let fallback = timer.time("Partial balancing (no feasible variant)", || {
+            super::partial::fallback::fallback(model, study.dmax, &front.found)
+        })?;
+        results.metadata.notes.push(fallback.note.clone());
+        Some(fallback)
+    };
     results.metadata.timings = timer.timings;
-    let written = report::write_outputs(out_dir, &results)?;
+    let mut written = report::write_outputs(out_dir, &results)?;
+    if let Some(f) = &fallback {
+        let json = out_dir.join(super::partial::fallback::PARTIAL_JSON);
+        super::write_atomic(&json, serde_json::to_string_pretty(&f.json)?.as_bytes())?;
+        written.push(json);
+        if !f.csv.is_empty() {
+            let csv = out_dir.join(super::partial::fallback::PARTIAL_CSV);
+            super::write_atomic(&csv, f.csv.as_bytes())?;
+            written.push(csv);
+        }
+    }
     print!("{}", report::text::summary(&results));
+    if let Some(f) = &fallback {
+        print!("{}", f.text);
+    }
     for f in written {
         println!("wrote {}", f.display());
     }

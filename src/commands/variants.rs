@@ -4,13 +4,13 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Result, bail};
-use counterpoise_balance::minimal::{MinimalReport, estimate_tested, minimal_search};
+use anyhow::{bail, Result};
+use counterpoise_balance::minimal::{estimate_tested, minimal_search, MinimalReport};
 use counterpoise_balance::{
-    Attachment, Catalogue, Class, Decision, SearchOptions, SearchReport, Status, VariantResult,
-    catalogue_options, mechanism_energy, realization_hints, search,
+    catalogue_options, mechanism_energy, realization_hints, search, Attachment, Catalogue, Class,
+    Decision, SearchOptions, SearchReport, Status, VariantResult,
 };
-use counterpoise_model::limits::{Limit, format_count};
+use counterpoise_model::limits::{format_count, Limit};
 use counterpoise_model::{Model, ModelError, Plane};
 use serde_json::json;
 
@@ -302,7 +302,7 @@ pub const WALK_TESTS_PER_VARIANT: u64 = 100;
 
 /// The variant guard of `--minimal`: the pruned walk's size (the reach pruning alone, an upper
 /// estimate of the sets it tests) against the variants limit, instead of `C(n, ≤ Dmax)`.
-fn minimal_guard(
+pub(super) fn minimal_guard(
     exact: &counterpoise_balance::exact::ExactBasis,
     dmax: usize,
     source: &str,
