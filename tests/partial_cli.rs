@@ -4,7 +4,7 @@
 mod common;
 
 use common::{assert_success, case_json, counterpoise, stderr, stdout, write_case};
-use serde_json::{json, Value};
+use serde_json::{Value, json};
 
 const G: f64 = 9.81;
 

@@ -9,18 +9,18 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use counterpoise_balance::linear::LiftedBasis;
 use counterpoise_balance::partial::{
-    counterweight_entries, partial_search, set_count, CounterweightLimits, PartialDesign,
-    PartialOptions, PartialReport, TorqueBasis, Workspace,
+    CounterweightLimits, PartialDesign, PartialOptions, PartialReport, TorqueBasis, Workspace,
+    counterweight_entries, partial_search, set_count,
 };
 use counterpoise_balance::search::decide;
 use counterpoise_balance::{
-    catalogue_options, mechanism_energy, realization_hints, Catalogue, Status, VerificationSet,
+    Catalogue, Status, VerificationSet, catalogue_options, mechanism_energy, realization_hints,
 };
 use counterpoise_dynamics::Evaluator;
-use counterpoise_model::limits::{format_count, Limit};
+use counterpoise_model::limits::{Limit, format_count};
 use counterpoise_model::{Model, ModelError};
 use counterpoise_optimise::{BoundsTable, ElementBounds};
 use serde_json::json;

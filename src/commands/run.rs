@@ -10,18 +10,18 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{Context as _, Result, bail};
 use counterpoise::shard::{self, ShardSpec};
 use counterpoise_balance::{
-    catalogue_options, mechanism_energy, realization_hints, search, Catalogue, SearchOptions,
-    SearchReport, Status, VariantResult,
+    Catalogue, SearchOptions, SearchReport, Status, VariantResult, catalogue_options,
+    mechanism_energy, realization_hints, search,
 };
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{
-    evaluate_grid, task_series_with, Counterweight, EvaluateOptions, Indicators, Spring, Variant,
+    Counterweight, EvaluateOptions, Indicators, Spring, Variant, evaluate_grid, task_series_with,
 };
 use counterpoise_model::Model;
-use counterpoise_optimise::{optimise_all_reporting, Context, Objective, OptimiseOptions};
+use counterpoise_optimise::{Context, Objective, OptimiseOptions, optimise_all_reporting};
 use counterpoise_report as report;
 use report::{
     ActuatorSummary, ElementInfo, ElementKind, Evaluation, FreeDirection, JointPeak, OptimiserInfo,

@@ -4,13 +4,13 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{bail, Result};
-use counterpoise_balance::minimal::{estimate_tested, minimal_search, MinimalReport};
+use anyhow::{Result, bail};
+use counterpoise_balance::minimal::{MinimalReport, estimate_tested, minimal_search};
 use counterpoise_balance::{
-    catalogue_options, mechanism_energy, realization_hints, search, Attachment, Catalogue, Class,
-    Decision, SearchOptions, SearchReport, Status, VariantResult,
+    Attachment, Catalogue, Class, Decision, SearchOptions, SearchReport, Status, VariantResult,
+    catalogue_options, mechanism_energy, realization_hints, search,
 };
-use counterpoise_model::limits::{format_count, Limit};
+use counterpoise_model::limits::{Limit, format_count};
 use counterpoise_model::{Model, ModelError, Plane};
 use serde_json::json;
 

@@ -11,13 +11,13 @@ use anyhow::Result;
 use counterpoise_balance::minimal::minimal_search;
 use counterpoise_balance::partial::counterweight_entries;
 use counterpoise_balance::{
-    catalogue_options, mechanism_energy, realization_hints, Catalogue, SearchOptions, SearchReport,
-    Status, VariantResult,
+    Catalogue, SearchOptions, SearchReport, Status, VariantResult, catalogue_options,
+    mechanism_energy, realization_hints,
 };
 use counterpoise_model::Model;
 use serde_json::json;
 
-use super::{change, compute, design_line, set_guard, Computed};
+use super::{Computed, change, compute, design_line, set_guard};
 
 /// How far past the study's Dmax the minimal-set walk looks for the smallest Dmax at which a
 /// variant balances: two more elements (the 6-axis arm of `cases/arm6.json` needs one more than
