@@ -978,9 +978,20 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
             guard += 1;
         }
         placed.push((x0, ty, tw, 0.0));
+        // A white card under the text: the front's dashed step runs at the point's height,
+        // through the label's middle, and a halo alone leaves it showing between the letters
+        // (bold text runs about 10 % wider than the estimate, hence the wider card).
+        let card = tw * 1.12 + 4.0;
+        let card_x = if right_side {
+            x0 - 2.0
+        } else {
+            x0 + tw + 2.0 - card
+        };
         let _ = write!(
             out,
-            r##"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="none" stroke="#111111" stroke-width="1.6"/><text x="{tx:.1}" y="{ty:.1}" font-size="{SMALL}" font-weight="600" text-anchor="{anchor}" stroke="#ffffff" stroke-width="3" paint-order="stroke">{}</text>"##,
+            r##"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="none" stroke="#111111" stroke-width="1.6"/><rect x="{card_x:.1}" y="{:.1}" width="{card:.1}" height="{:.1}" fill="#ffffff" fill-opacity="0.9"/><text x="{tx:.1}" y="{ty:.1}" font-size="{SMALL}" font-weight="600" text-anchor="{anchor}" stroke="#ffffff" stroke-width="3" paint-order="stroke">{}</text>"##,
+            ty - 0.8 * SMALL - 1.0,
+            SMALL + 3.0,
             escape_html(text)
         );
     }
