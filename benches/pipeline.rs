@@ -23,12 +23,8 @@ use std::time::Duration;
 #[path = "../tests/common/variants.rs"]
 mod variants;
 
-use variants::dynamics_variant;
+use variants::{balanced, dynamics_variant};
 
-use counterpoise_balance::{
-    Catalogue, SearchOptions, Status, VariantResult, catalogue_options, mechanism_energy,
-    realization_hints, search,
-};
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{
     Combination, Counterweight, EvaluateOptions, Spring, Variant, evaluate_grid_indicators,
@@ -41,22 +37,6 @@ use criterion::{Criterion, criterion_group, criterion_main};
 fn palletizer() -> Model {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/palletizer.json");
     Case::from_path(&path).expect("the palletizer case loads")
-}
-
-fn balanced(model: &Model, dmax: usize) -> Vec<VariantResult> {
-    let energy = mechanism_energy(model);
-    search(
-        &energy,
-        Catalogue::build(&energy, &catalogue_options(model)),
-        SearchOptions {
-            dmax,
-            hints: realization_hints(model),
-        },
-    )
-    .variants
-    .into_iter()
-    .filter(|v| v.status == Status::Balanced)
-    .collect()
 }
 
 /// Phase 1, the search and the optimisation, as `run` chains them.

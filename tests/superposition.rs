@@ -8,12 +8,8 @@ mod common;
 
 use std::time::Instant;
 
-use common::variants::dynamics_variant;
+use common::variants::{balanced, dynamics_variant};
 
-use counterpoise_balance::{
-    Catalogue, SearchOptions, Status, catalogue_options, mechanism_energy, realization_hints,
-    search,
-};
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{
     Combination, Counterweight, EvaluateOptions, Indicators, Spring, Variant, evaluate_grid,
@@ -38,21 +34,7 @@ fn every_reaction_peak_of_every_feasible_dmax2_variant_equals_the_direct_solve()
         &EvaluateOptions::default(),
     )
     .expect("phase 1");
-    let energy = mechanism_energy(&model);
-    let found = search(
-        &energy,
-        Catalogue::build(&energy, &catalogue_options(&model)),
-        SearchOptions {
-            dmax: 2,
-            hints: realization_hints(&model),
-        },
-    );
-    let balanced: Vec<_> = found
-        .variants
-        .iter()
-        .filter(|v| v.status == Status::Balanced)
-        .cloned()
-        .collect();
+    let balanced = balanced(&model, 2);
     let ctx = Context::new(&model, Some(ub.indicators.swap_remove(0))).unwrap();
     let optimised = optimise_all(&ctx, &balanced, &OptimiseOptions::default());
     let variants: Vec<Variant> = optimised
