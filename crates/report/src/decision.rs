@@ -170,6 +170,10 @@ fn recommend(
     if left.is_empty() {
         return None;
     }
+    // A criterion with a margin keeps values near its best: when the pick is one of those, its
+    // step is re-worded after the pick with both values ("4.11 kg against the least 3.94 kg"),
+    // never "has the least" for a value that is not.
+    let mut near: Vec<(usize, Reword)> = Vec::new();
     // 1. added mass
     let best = left
         .iter()
@@ -187,17 +191,59 @@ fn recommend(
             format!("the least added mass ({}{share})", mass(best))
         },
     );
+    // (The first criterion: its step, when it narrowed, is step 0.)
+    if steps.len() == 1 {
+        let share = move |m: f64| {
+            moving_mass
+                .filter(|mm| *mm > 0.0)
+                .map(|mm| format!(", {:.1} %", m / mm * 100.0))
+                .unwrap_or_default()
+        };
+        near.push((
+            0,
+            Box::new(move |v| {
+                let own = added_mass(v);
+                (mass(own) != mass(best)).then(|| {
+                    format!(
+                        "an added mass within {} % of the moving mass of the least ({}{} against {}{})",
+                        trim(MASS_MARGIN_PERCENT),
+                        mass(own),
+                        share(own),
+                        mass(best),
+                        share(best)
+                    )
+                })
+            }),
+        ));
+    }
     // 2. ΔR
     let best = left
         .iter()
         .map(|v| v.dr.unwrap_or(0.0))
         .fold(f64::INFINITY, f64::min);
+    let before = steps.len();
     narrow(
         &mut left,
         &mut steps,
         |v| v.dr.unwrap_or(0.0) <= best + tolerance,
         || format!("the lowest ΔR ({} %)", percent(best)),
     );
+    if steps.len() > before {
+        near.push((
+            before,
+            Box::new(move |v| {
+                let own = v.dr.unwrap_or(0.0);
+                (percent(own) != percent(best)).then(|| {
+                    format!(
+                        "a ΔR within {} percentage points of the lowest ({} % against {} %)",
+                        trim(tolerance),
+                        percent(own),
+                        percent(best)
+                    )
+                })
+            }),
+        ));
+    }
     // 3. element count
     let best = left.iter().map(|v| elements(v)).min().unwrap_or(0);
     narrow(
@@ -211,6 +257,7 @@ fn recommend(
         .iter()
         .map(|v| spring_force(v))
         .fold(f64::INFINITY, f64::min);
+    let before = steps.len();
     narrow(
         &mut left,
         &mut steps,
@@ -222,8 +269,30 @@ fn recommend(
             )
         },
     );
+    if steps.len() > before {
+        near.push((
+            before,
+            Box::new(move |v| {
+                let own = spring_force(v);
+                let f = crate::format::force;
+                (f(own) != f(best)).then(|| {
+                    format!(
+                        "a peak spring force within {} % of the smallest ({} against {})",
+                        trim(FORCE_MARGIN * 100.0),
+                        f(own),
+                        f(best)
+                    )
+                })
+            }),
+        ));
+    }
     // 5. rank: `left` is in rank order.
     let chosen = left[0];
+    for (k, reword) in &near {
+        if let Some(text) = reword(chosen) {
+            steps[*k] = text;
+        }
+    }
     if left.len() > 1 {
         steps.push(format!("the best rank ({})", chosen.rank.unwrap_or(0)));
     }
@@ -283,6 +352,9 @@ fn recommend(
 }
 
 /// Keeps the candidates passing `keep`; records the step when it removed one.
+/// The words of a step for the pick when its value is not the step's best (`None` when it is).
+type Reword = Box<dyn Fn(&VariantRecord) -> Option<String>>;
+
 fn narrow(
     left: &mut Vec<&VariantRecord>,
     steps: &mut Vec<String>,
@@ -533,6 +605,57 @@ mod tests {
         let ranked: Vec<&VariantRecord> = vs.iter().collect();
         let reason = decide(&ranked, 0.5, Some(0.0)).overall.unwrap().reason;
         assert!(!reason.contains("moving mass"), "{reason}");
+    }
+
+    /// A pick within a margin of a criterion's best is not said to have the best: the reason
+    /// gives its own value against the best (issue 31: the Dmax 3 hybrid pick, 4.11 kg, was
+    /// said to have "the least added mass (3.94 kg)").
+    #[test]
+    fn a_pick_within_the_margin_is_worded_with_both_values() {
+        let vs = [
+            v(
+                1,
+                1,
+                &["m1"],
+                Class::Counterweights,
+                (-60.0, -50.0, 2.0),
+                (5.0, None),
+            ),
+            v(
+                2,
+                2,
+                &["m2"],
+                Class::Counterweights,
+                (-60.0, -50.0, 0.0),
+                (14.0, None),
+            ),
+            v(
+                3,
+                3,
+                &["m3"],
+                Class::Counterweights,
+                (-60.0, -50.0, 0.0),
+                (30.0, None),
+            ),
+        ];
+        let ranked: Vec<&VariantRecord> = vs.iter().collect();
+        let o = decide(&ranked, 0.5, Some(1000.0)).overall.unwrap();
+        // The mass margin is 1 % of 1000 kg (10 kg) above the least, 5 kg: 30 kg is out, 14 kg
+        // in; ΔR then decides for SB2.
+        assert_eq!(o.chosen, 2);
+        assert!(
+            o.reason.contains(
+                "an added mass within 1 % of the moving mass of the least (14.00 kg, 1.4 % against \
+                 5.00 kg, 0.5 %), then the lowest ΔR (0.00 %)"
+            ),
+            "{}",
+            o.reason
+        );
+        assert!(
+            !o.reason.contains("has the least added mass"),
+            "{}",
+            o.reason
+        );
     }
 
     /// Spring forces within 5 % tie (1040 N against 1000 N: 4 %), so the rank decides; 1060 N
