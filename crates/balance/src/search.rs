@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::element::{Attachment, Catalogue, CatalogueEntry, Element};
 use crate::energy::MechanismEnergy;
 use crate::enumerate::variants;
-use crate::exact::{ExactBasis, ExactField, ExactSolution, positivity, rank_one};
+use crate::exact::{ExactBasis, ExactField, ExactSolution, positivity, rank_one, split};
 use crate::linear::{LiftedBasis, solve};
 use crate::realize::{Realization, RealizationHints, Witness, find_witness, realize};
 use crate::relations::{
@@ -358,6 +358,33 @@ fn decide_exact<F: ExactField>(
         let linear = crate::linear::from_exact(numeric, &restricted);
         if let Ok(witness) = find_witness(&linear, &numeric.unbalanced, entries, hints) {
             return accept_witness(checks, witness, result);
+        }
+    }
+    // Springs whose balance zeroes a block of W: split on which anchor part vanishes.
+    let springs = refs
+        .iter()
+        .filter(|e| matches!(e.element, Element::Spring { .. }))
+        .count();
+    if springs > 0 {
+        let sign_proof = |s: &ExactSolution<F>| exact_sign_proof(s, entries);
+        match split::refute(exact, &set, entries, &[], springs, &sign_proof) {
+            split::Outcome::Proof(reason) => {
+                result.status = Status::Unrealizable;
+                result.reason = Some(reason);
+                return;
+            }
+            split::Outcome::Open(leaves) => {
+                for rows in leaves.iter().filter(|rows| !rows.is_empty()).take(4) {
+                    let restricted = exact.solve_with(&set, rows);
+                    let linear = crate::linear::from_exact(numeric, &restricted);
+                    if linear.ensure_finite().is_err() {
+                        continue;
+                    }
+                    if let Ok(w) = find_witness(&linear, &numeric.unbalanced, entries, hints) {
+                        return accept_witness(checks, w, result);
+                    }
+                }
+            }
         }
     }
     result.status = Status::Undecided;

@@ -19,6 +19,7 @@ pub mod elimination_field;
 pub mod field;
 pub mod positivity;
 pub mod rank_one;
+pub mod split;
 
 use std::collections::BTreeMap;
 

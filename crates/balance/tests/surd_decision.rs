@@ -1,0 +1,212 @@
+//! The exact decision over ℚ(√2, √3): a three-chain leg whose chains are 120° apart
+//! (cos = −1/2, sin = √3/2) and a chain tilted by 45° take the exact path, with hand-derived
+//! verdicts, and the exact and numeric paths agree on random multiples of π/12.
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::{find, labels, model_of, run};
+use counterpoise_balance::{
+    Catalogue, Decision, SearchOptions, SearchReport, Status, catalogue_options, mechanism_energy,
+    realization_hints, search,
+};
+use counterpoise_model::Model;
+use counterpoise_model::sampling::SplitMix64;
+
+fn leg_json() -> serde_json::Value {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/three_chain_leg.json");
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The search with the exact fields withheld: the numeric path on the same mechanism.
+fn run_numeric(model: &Model, dmax: usize) -> SearchReport {
+    let mut energy = mechanism_energy(model);
+    energy.exact = Err("withheld by the test".into());
+    energy.surd = Err("withheld by the test".into());
+    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
+    search(
+        &energy,
+        catalogue,
+        SearchOptions {
+            dmax,
+            hints: realization_hints(model),
+        },
+    )
+}
+
+fn inter_chain_spring(label: &str) -> bool {
+    // K21, K31, K32: springs between two chains (K10, K20, K30 go to the base).
+    label.starts_with('K') && !label.ends_with('0')
+}
+
+/// By hand: chain k's potential is `m g 0.25 sin q_k` in its own angle only, so a set balances
+/// only if every chain carries one of its own elements (its counterweight `mk` or its base
+/// spring `Kk0`; a pendulum is balanced by either). Among counterweights and base springs at
+/// Dmax 3 that is one element per chain: 2³ = 8 sets, all realizable; the other 41 − 8 = 33
+/// leave a chain without an element and are infeasible. None may stay undecided.
+#[test]
+fn the_120_degree_leg_is_decided_exactly_over_the_surd_field() {
+    let model = model_of(&leg_json());
+    let energy = mechanism_energy(&model);
+    let reason = energy.exact.as_ref().unwrap_err();
+    assert!(reason.contains("π/2"), "{reason}");
+    assert!(energy.surd.is_ok(), "{:?}", energy.surd.as_ref().err());
+    let report = run(&model, 3);
+    assert_eq!(report.variants.len(), 9 + 36 + 84);
+    assert!(
+        report
+            .variants
+            .iter()
+            .all(|v| v.decision == Decision::Exact)
+    );
+    let simple: Vec<_> = report
+        .variants
+        .iter()
+        .filter(|v| !labels(v).iter().any(|l| inter_chain_spring(l)))
+        .collect();
+    assert_eq!(simple.len(), 6 + 15 + 20);
+    let realizable = simple
+        .iter()
+        .filter(|v| matches!(v.status, Status::Balanced | Status::Degenerate))
+        .count();
+    let infeasible = simple
+        .iter()
+        .filter(|v| v.status == Status::Infeasible)
+        .count();
+    assert_eq!((realizable, infeasible), (8, 33));
+    // m·r_x·g·sin q cancels 1.2·9.81·0.25·sin q: m·r_x = −0.3 kg·m on every chain, the √3 of
+    // chains 2 and 3 cancelling exactly.
+    let all_masses = find(&report, &["m1", "m2", "m3"]);
+    assert_eq!(all_masses.status, Status::Balanced);
+    for k in 1..=3 {
+        let relation = format!("m{k}·r{k}x = -3/10 (-0.3) kg·m");
+        assert!(
+            all_masses.relations.contains(&relation),
+            "{:?}",
+            all_masses.relations
+        );
+    }
+    assert_eq!(
+        find(&report, &["K10", "K20", "K30"]).status,
+        Status::Balanced
+    );
+}
+
+/// m1 + K32: chain 1 by its counterweight, chains 2 and 3 by one spring between them. The cross
+/// terms `cos q2 cos q3`, … come from K32 alone; with the chains' x axes 120° apart
+/// (e₂·e₃ = −1/2) they force, by hand, `−½ax·bx + az·bz = 0`, `−½ax·bz − az·bx = 0`,
+/// `−½az·bx − ax·bz = 0`, `−½az·bz + ax·bx = 0` (the x–z block of K·a·bᵀ), whose only solution
+/// is that block zero: a's x, z or b's x, z vanish, and then K32 cannot torque chain 3 (or 2).
+#[test]
+fn a_spring_between_two_chains_cannot_balance_both() {
+    let report = run(&model_of(&leg_json()), 2);
+    let v = find(&report, &["m1", "K32"]);
+    assert_eq!(v.status, Status::Unrealizable, "{:?}", v.reason);
+    let reason = v.reason.as_deref().unwrap();
+    assert!(
+        reason.starts_with("K32: balance makes K·a_i·b_j = 0 for i ∈ {x, z}, j ∈ {x, z}"),
+        "{reason}"
+    );
+    assert!(reason.contains("with a's x, z zero, the balance equations have no solution"));
+}
+
+/// A chain tilted by 45°: `rot_x(pi/4)` then `rot_y(q)`, CoM 0.25 m along x. Its height is
+/// `−0.25 sin q · cos 45°`, so V = −1.2·9.81·0.25·(√2/2)·sin q and a counterweight balances it
+/// with m·r_x = −0.3 kg·m, m·r_z = 0 (the √2/2 divides out).
+#[test]
+fn a_chain_at_45_degrees_is_exact_over_the_surd_field() {
+    let mut case = leg_json();
+    case["bodies"] = serde_json::json!([
+        { "name": "link1", "parent": "base",
+          "pose": [ { "rot_x": "pi/4" }, { "rot_y": "q1" } ],
+          "mass": 1.2, "com": [0.25, 0, 0], "inertia": [0.001, 0.01, 0.01, 0, 0, 0] }
+    ]);
+    case["coordinates"] = serde_json::json!([
+        { "name": "q1", "kind": "angle", "range": [-1.5, 1.5] }
+    ]);
+    case["joints"] = serde_json::json!([
+        { "name": "J1", "kind": "revolute", "bodies": ["base", "link1"], "point": [0, 0, 0],
+          "axis": [0, "cos(pi/4)", "sin(pi/4)"] }
+    ]);
+    case["actuators"] = serde_json::json!([
+        { "name": "M1", "joint": "J1", "coordinate": "q1", "ratio": 0.01 }
+    ]);
+    let model = model_of(&case);
+    let energy = mechanism_energy(&model);
+    assert!(energy.exact.is_err());
+    assert!(energy.surd.is_ok());
+    let report = run(&model, 2);
+    let m1 = find(&report, &["m1"]);
+    assert_eq!(m1.decision, Decision::Exact);
+    assert_eq!(m1.status, Status::Balanced);
+    assert!(
+        m1.relations
+            .contains(&"m1·r1x = -3/10 (-0.3) kg·m".to_string()),
+        "{:?}",
+        m1.relations
+    );
+    assert!(m1.relations.contains(&"m1·r1z = 0 kg·m".to_string()));
+    assert!(
+        report
+            .variants
+            .iter()
+            .all(|v| v.status != Status::Undecided)
+    );
+}
+
+/// Property: on legs whose chains sit at random multiples of π/12 (random tilts and CoMs too),
+/// the exact path over ℚ(√2, √3) and the numeric path never contradict each other: where the
+/// numeric path reaches a verdict it is the exact one (a numeric witness is verified by sampling
+/// the energy, so it also checks every exact proof of unrealizability).
+#[test]
+fn exact_and_numeric_paths_agree_on_random_twelfths() {
+    let mut rng = SplitMix64::new(2026);
+    let mut compared = 0;
+    for _ in 0..3 {
+        let mut case = leg_json();
+        for b in 0..3 {
+            let turn = (rng.next_u64() % 24) as i64 - 12;
+            let tilt = (rng.next_u64() % 5) as i64 - 2;
+            let com = 0.1 + 0.05 * (rng.next_u64() % 5) as f64;
+            case["bodies"][b]["pose"] = serde_json::json!([
+                { "rot_z": format!("{turn}*pi/12") },
+                { "translate": [0.3, 0, 0] },
+                { "rot_x": format!("{tilt}*pi/12") },
+                { "rot_y": format!("q{}", b + 1) }
+            ]);
+            case["bodies"][b]["com"] = serde_json::json!([com, 0, 0]);
+            // The joint in base axes: point R_z(θ)·(0.3, 0, 0), axis R_z(θ)·R_x(φ)·(0, 1, 0).
+            let (t, p) = (format!("{turn}*pi/12"), format!("{tilt}*pi/12"));
+            case["joints"][b]["point"] =
+                serde_json::json!([format!("0.3*cos({t})"), format!("0.3*sin({t})"), 0]);
+            case["joints"][b]["axis"] = serde_json::json!([
+                format!("-sin({t})*cos({p})"),
+                format!("cos({t})*cos({p})"),
+                format!("sin({p})")
+            ]);
+        }
+        let model = model_of(&case);
+        let exact = run(&model, 2);
+        let numeric = run_numeric(&model, 2);
+        for (e, n) in exact.variants.iter().zip(&numeric.variants) {
+            assert_eq!(labels(e), labels(n));
+            assert_eq!(e.decision, Decision::Exact);
+            assert_eq!(n.decision, Decision::Numeric);
+            if e.status == Status::Undecided || n.status == Status::Undecided {
+                continue;
+            }
+            compared += 1;
+            assert_eq!(
+                e.status,
+                n.status,
+                "{:?} in {}: exact {:?}, numeric {:?}",
+                labels(e),
+                case["bodies"],
+                e.reason,
+                n.reason
+            );
+        }
+    }
+    assert!(compared >= 3 * 30, "only {compared} verdicts compared");
+}
