@@ -326,6 +326,13 @@ fn change(value: f64, reference: f64) -> f64 {
     }
 }
 
+/// Metres in millimetres rounded to 0.1 mm, a value that rounds to zero shown as `0.0` (not
+/// `-0.0`: the solver's −4e-5 mm is no direction).
+fn millimetres(metres: f64) -> f64 {
+    let mm = (metres * 1e4).round() / 10.0;
+    if mm == 0.0 { 0.0 } else { mm }
+}
+
 fn design_line(model: &Model, d: &PartialDesign) -> String {
     d.counterweights
         .iter()
@@ -338,9 +345,9 @@ fn design_line(model: &Model, d: &PartialDesign) -> String {
                 format!(
                     "{label}: m = {:.3} kg at r = ({:.1}, {:.1}, {:.1}) mm (|r| = {:.1} mm, on {})",
                     c.mass,
-                    c.offset[0] * 1e3,
-                    c.offset[1] * 1e3,
-                    c.offset[2] * 1e3,
+                    millimetres(c.offset[0]),
+                    millimetres(c.offset[1]),
+                    millimetres(c.offset[2]),
                     r * 1e3,
                     model.bodies[c.body].name
                 )
@@ -472,4 +479,18 @@ pub fn to_json(model: &Model, computed: &Computed) -> serde_json::Value {
         "exact": exact,
         "designs": report.designs,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::millimetres;
+
+    /// 0.4255 m is 425.5 mm; −4·10⁻⁸ m (a solver's zero) prints as `0.0`, not `-0.0`; −0.7 mm
+    /// keeps its sign.
+    #[test]
+    fn millimetres_round_to_a_tenth_without_a_negative_zero() {
+        assert_eq!(format!("{:.1}", millimetres(0.4255)), "425.5");
+        assert_eq!(format!("{:.1}", millimetres(-4e-8)), "0.0");
+        assert_eq!(format!("{:.1}", millimetres(-0.0007)), "-0.7");
+    }
 }
