@@ -856,6 +856,24 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
     }
     y_axis(&mut out, &f, &chart.y_label);
     x_axis(&mut out, &f, height, &chart.x_label);
+    // The front over the band (it lies inside it), under the markers and the callouts' cards.
+    if chart.front.len() > 1 {
+        let mut pts = String::new();
+        for (k, (x, y)) in chart.front.iter().enumerate() {
+            if k > 0 {
+                // Step: the next point's mass at the previous point's ΔQTR.
+                let _ = write!(pts, "{:.1},{:.1} ", f.x(*x), f.y(chart.front[k - 1].1));
+            }
+            let _ = write!(pts, "{:.1},{:.1} ", f.x(*x), f.y(*y));
+        }
+        let _ = write!(
+            out,
+            r##"<polyline points="{}" fill="none" stroke="#333333" stroke-width="1.4" stroke-dasharray="5 3"><title>non-dominated front (no variant is lighter and better on ΔQTR)</title></polyline>"##,
+            pts.trim_end()
+        );
+    }
+    // The callouts' white cards go here, under the markers (inserted once they are placed).
+    let cards_at = out.len();
     // Points drawn at the same pixel (e.g. every spring-only variant: no added mass, the same
     // ΔQTR) are one marker, the largest of them, with their count beside it and all of them
     // in its tooltip.
@@ -914,22 +932,6 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
         }
         out.push_str("</g>");
     }
-    // The front on top of the markers and the band, so it stays visible.
-    if chart.front.len() > 1 {
-        let mut pts = String::new();
-        for (k, (x, y)) in chart.front.iter().enumerate() {
-            if k > 0 {
-                // Step: the next point's mass at the previous point's ΔQTR.
-                let _ = write!(pts, "{:.1},{:.1} ", f.x(*x), f.y(chart.front[k - 1].1));
-            }
-            let _ = write!(pts, "{:.1},{:.1} ", f.x(*x), f.y(*y));
-        }
-        let _ = write!(
-            out,
-            r##"<polyline points="{}" fill="none" stroke="#333333" stroke-width="1.4" stroke-dasharray="5 3"><title>non-dominated front (no variant is lighter and better on ΔQTR)</title></polyline>"##,
-            pts.trim_end()
-        );
-    }
     // Callouts: points at nearly the same pixel share one label; labels are stacked so none
     // overprints another.
     let mut callouts: Vec<(f64, f64, f64, String)> = Vec::new();
@@ -952,6 +954,7 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
         }
     }
     let mut placed: Vec<(f64, f64, f64, f64)> = Vec::new();
+    let mut cards = String::new();
     for (x, y, r, text) in &callouts {
         let tw = text_width(text, SMALL);
         let right_side = x + r + 4.0 + tw < left + f.w;
@@ -978,9 +981,10 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
             guard += 1;
         }
         placed.push((x0, ty, tw, 0.0));
-        // A white card under the text: the front's dashed step runs at the point's height,
-        // through the label's middle, and a halo alone leaves it showing between the letters
-        // (bold text runs about 10 % wider than the estimate, hence the wider card).
+        // A white card under the text hides the front's dashed step, which runs at the point's
+        // height through the label's middle (a halo alone leaves it showing between the
+        // letters); drawn under the markers, it hides no point (bold text runs about 10 % wider
+        // than the estimate, hence the wider card).
         let card = tw * 1.12 + 4.0;
         let card_x = if right_side {
             x0 - 2.0
@@ -988,13 +992,18 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
             x0 + tw + 2.0 - card
         };
         let _ = write!(
-            out,
-            r##"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="none" stroke="#111111" stroke-width="1.6"/><rect x="{card_x:.1}" y="{:.1}" width="{card:.1}" height="{:.1}" fill="#ffffff" fill-opacity="0.9"/><text x="{tx:.1}" y="{ty:.1}" font-size="{SMALL}" font-weight="600" text-anchor="{anchor}" stroke="#ffffff" stroke-width="3" paint-order="stroke">{}</text>"##,
+            cards,
+            r##"<rect x="{card_x:.1}" y="{:.1}" width="{card:.1}" height="{:.1}" fill="#ffffff" class="card"/>"##,
             ty - 0.8 * SMALL - 1.0,
             SMALL + 3.0,
+        );
+        let _ = write!(
+            out,
+            r##"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="none" stroke="#111111" stroke-width="1.6"/><text x="{tx:.1}" y="{ty:.1}" font-size="{SMALL}" font-weight="600" text-anchor="{anchor}" stroke="#ffffff" stroke-width="3" paint-order="stroke">{}</text>"##,
             escape_html(text)
         );
     }
+    out.insert_str(cards_at, &cards);
     out.push_str("</svg>");
     out
 }
@@ -1218,6 +1227,12 @@ mod tests {
         assert!(svg.contains("SB1 (overall); SB2 (springs)"));
         // The front is drawn after the band (on top of it).
         assert!(svg.find("<polyline").unwrap() > svg.find("fill=\"#fff3cd\"").unwrap());
+        // Then the callouts' white cards, hiding the front under the labels, then the markers
+        // over the cards (no point hidden), then the labels.
+        let card = svg.find("class=\"card\"").unwrap();
+        assert!(svg.find("<polyline").unwrap() < card);
+        assert!(card < svg.find("<g><title>").unwrap());
+        assert!(svg.find("<g><title>").unwrap() < svg.find("SB1 (overall); SB2").unwrap());
         // The largest marker (11 px) stays inside the frame: its top below the frame's top.
         let frame_top: f64 = {
             let k = svg.find("<rect x=").unwrap();
