@@ -256,4 +256,28 @@ mod tests {
         expected.add_term(Monomial::base(0), q(2 * 981 * 4, 100));
         assert_eq!(exact.unbalanced, expected);
     }
+
+    #[test]
+    fn a_twelfth_turn_is_exact_over_the_surd_field_only() {
+        // rot_z(th + 2π/3), CoM 2 along x: y = 2 sin(th + 120°) = 2(sin th·(−1/2) + cos th·√3/2)
+        // = −sin th + √3 cos th, so V = m g y = 2·9.81·(−sin th + √3 cos th).
+        let text = PENDULUM
+            .replace("th - pi/2", "th + 2*pi/3")
+            .replace("\"4*l/3\", 0, 0", "2, 0, 0");
+        let model = crate::Case::from_json_str(&text).unwrap();
+        let err = exact_mechanism(&model).unwrap_err();
+        assert!(err.reason.contains("π/2"), "{err}");
+        let exact = exact_mechanism_in::<Surd>(&model).unwrap();
+        let g2 = q(2 * 981, 100);
+        let mut expected = Poly::<Surd>::zero();
+        expected.add_term(Monomial::sine(0), Surd::from_rational(-g2.clone()));
+        expected.add_term(Monomial::base(0), &Surd::sqrt3() * &Surd::from_rational(g2));
+        assert_eq!(exact.unbalanced, expected);
+        // 0.3 rad is in neither field.
+        let text = PENDULUM.replace("th - pi/2", "th + 0.3");
+        let model = crate::Case::from_json_str(&text).unwrap();
+        let err = exact_mechanism_in::<Surd>(&model).unwrap_err();
+        assert_eq!(err.path, "bodies[0].pose[0].rot_z");
+        assert!(err.reason.contains("pi/12"), "{err}");
+    }
 }
