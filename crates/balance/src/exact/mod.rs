@@ -1,4 +1,6 @@
-//! The exact balance decision: the lifted system `A_S x = −b` over ℚ.
+//! The exact balance decision: the lifted system `A_S x = −b` over ℚ, or over ℚ(√2, √3) when
+//! the case's rotations are multiples of π/12 ([`field`]; everything here is generic over the
+//! field, and the search tries ℚ first).
 //!
 //! When every number of the case is rational (see [`counterpoise_model::exact_mechanism`]) the
 //! energy coefficients of the mechanism and of every element are rational, computed by the same
@@ -12,7 +14,8 @@
 //!
 //! Positivity of masses and stiffnesses over the family is decided exactly too ([`positivity`]),
 //! with a Farkas certificate when it fails, and the admissible range of each lifted variable is
-//! the projection of the positive family.
+//! the projection of the positive family. Springs whose balance zeroes a block of `K·a·bᵀ` are
+//! split on which anchor part vanishes ([`split`]).
 
 pub mod elimination;
 pub mod elimination_field;
