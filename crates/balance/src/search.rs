@@ -387,6 +387,16 @@ fn decide_exact<F: ExactField>(
             }
         }
     }
+    // The same family in the SVD's basis, where floating point agrees with the exact facts: the
+    // witness search starts from another point of it (any witness is verified all the same).
+    let svd = crate::linear::numeric_solve(numeric, &set);
+    if svd.ambiguity.is_none()
+        && svd.consistent
+        && svd.rank == solution.rank()
+        && let Ok(w) = find_witness(&svd, &numeric.unbalanced, entries, hints)
+    {
+        return accept_witness(checks, w, result);
+    }
     result.status = Status::Undecided;
     result.reason = Some(witness);
 }
