@@ -236,6 +236,24 @@ mod tests {
     }
 
     #[test]
+    fn huge_multiples_of_a_twelfth_reduce_modulo_a_turn() {
+        // (24·10²⁰ + 2)·π/12 is 10²⁰ whole turns plus π/6: (√3/2, 1/2), without overflow.
+        let turns = Rational::from_integer(num_bigint::BigInt::from(10).pow(20) * 24 + 2);
+        let angle = Surd::mul_constants(
+            &Surd::from_scalar(Surd::from_rational(turns / q(12, 1))),
+            &Surd::pi(),
+        )
+        .unwrap();
+        assert_eq!(
+            Surd::cos_sin(&angle),
+            Ok((
+                Surd::new(q(0, 1), q(0, 1), q(1, 2), q(0, 1)),
+                Surd::from_rational(q(1, 2))
+            ))
+        );
+    }
+
+    #[test]
     fn rational_rotations_combine_with_twelfths() {
         // atan2(4, 3) + π/3: cos = 3/5·1/2 − 4/5·√3/2 = 3/10 − 2/5√3,
         // sin = 4/5·1/2 + 3/5·√3/2 = 2/5 + 3/10√3.
