@@ -200,3 +200,65 @@ where
         Outcome::Open(leaves)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::element::Attachment;
+    use counterpoise_symbolic::{Monomial, Rational};
+    use num_bigint::BigInt;
+
+    /// One spring `(K, αx, αy, βx, βy, Wxx, Wxy, Wyx, Wyy)` with the balance rows given as
+    /// `(variable, right-hand side)`: `x_variable = value`.
+    fn rectangles_of(rows: &[(usize, i64)]) -> Vec<(Vec<usize>, Vec<usize>)> {
+        let entry = CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0, 1],
+                axes_b: vec![0, 1],
+            },
+            label: "K1".into(),
+            description: "spring".into(),
+            variables: Vec::new(),
+            energy: Vec::new(),
+        };
+        let mut columns = vec![vec![BigInt::from(0); rows.len()]; 9];
+        for (r, &(j, _)) in rows.iter().enumerate() {
+            columns[j][r] = BigInt::from(1);
+        }
+        let basis = ExactBasis {
+            monomials: (0..rows.len()).map(Monomial::sine).collect(),
+            unbalanced: rows.iter().map(|&(_, v)| BigInt::from(-v)).collect(),
+            elements: vec![columns],
+            row_factors: vec![Rational::from_integer(1.into()); rows.len()],
+        };
+        let solution = basis.solve(&[0]);
+        rectangles(&solution, &[(0, &entry)])
+            .into_iter()
+            .map(|r| (r.rows, r.columns))
+            .collect()
+    }
+
+    #[test]
+    fn zero_blocks_are_found_maximal_and_only_when_a_split_says_something() {
+        // K = 1, Wxx = 0: the one block is {x}×{x} (Wxy, Wyx, Wyy are free).
+        assert_eq!(rectangles_of(&[(0, 1), (5, 0)]), vec![(vec![0], vec![0])]);
+        // Wxx = Wxy = 0: the row x of W is zero, a block {x}×{x, y}, not {x}×{x}.
+        assert_eq!(
+            rectangles_of(&[(0, 1), (5, 0), (6, 0)]),
+            vec![(vec![0], vec![0, 1])]
+        );
+        // Wxx = Wyx = 0: the column x, {x, y}×{x}.
+        assert_eq!(
+            rectangles_of(&[(0, 1), (5, 0), (7, 0)]),
+            vec![(vec![0, 1], vec![0])]
+        );
+        // With αx = 0 already, splitting on {x}×{x} changes nothing: no block.
+        assert!(rectangles_of(&[(0, 1), (5, 0), (1, 0)]).is_empty());
+        // Likewise with βx = 0.
+        assert!(rectangles_of(&[(0, 1), (5, 0), (3, 0)]).is_empty());
+        // Wxx = 1: nothing is zero.
+        assert!(rectangles_of(&[(0, 1), (5, 1)]).is_empty());
+    }
+}
