@@ -144,8 +144,9 @@ enum Command {
         /// variant's objective is within it of the certified lower bound.
         #[arg(long, default_value_t = 1e-3, value_name = "REL", value_parser = parse_gap)]
         gap: f64,
-        /// Boxes the certified search may solve per variant and pass; a variant that reaches
-        /// the limit before a verdict ends undecided, and says so.
+        /// Boxes the certified search may solve per variant and pass once a design is known
+        /// (four times as many while none is); a variant that reaches the limit before a
+        /// verdict ends undecided, and says so.
         #[arg(long, default_value_t = counterpoise_optimise::certify::DEFAULT_MAX_NODES as u64, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
         max_nodes: u64,
         /// Seed of the local search's starting points (verdicts, optima and ranks do not

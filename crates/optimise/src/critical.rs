@@ -554,8 +554,11 @@ fn step(
             lower_bound,
             nodes,
         } => Err(Failure::Undecided(format!(
-            "the search stopped at its limit of {nodes} boxes (--max-nodes) before finding a \
-             design within the bounds or proving that none exists (lower bound {:.4} N·m)",
+            "the search stopped at its limit of {} boxes ({} × --max-nodes while no design is \
+             known; {nodes} solved in this pass) before finding a design within the bounds or \
+             proving that none exists (lower bound {:.4} N·m)",
+            branch.box_limit(false),
+            crate::certify::NO_DESIGN_BUDGET_FACTOR,
             lower_bound.max(lower)
         ))),
         Verdict::Impossible { nodes } => Err(Failure::Discard(impossibility_certificate(

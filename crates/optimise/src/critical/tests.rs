@@ -429,3 +429,58 @@ fn a_search_resumed_on_more_tasks_ends_where_a_fresh_one_does() {
         "resumed {warm_nodes} boxes, fresh {cold_nodes}"
     );
 }
+
+/// A search without a design may spend four times `max_nodes` boxes before it stops: a proof
+/// of impossibility that needs `n` boxes ends `Impossible` with a limit of `⌈n/4⌉`, and stops
+/// `undecided` (no design) below `n/4`. The pendulum with a counterweight m1 of at most 0.1 kg
+/// at 1 m (0.98 N·m) and a spring K10 of at most 100 N/m between anchors within 0.3 m and
+/// 0.2 m (6 N·m) cannot carry the rod's 9.81 N·m (by hand: 6.98 < 9.81).
+#[test]
+fn a_search_without_a_design_has_four_times_the_box_budget() {
+    let mut json = case_json("pendulum.json");
+    let b = &mut json["balancing"];
+    b["bounds"] = serde_json::json!({
+        "mass": [0.0, 0.1], "radius": [0.0, 1.0],
+        "stiffness": [1.0, 100.0], "anchor_a": [0.0, 0.3], "anchor_b": [0.0, 0.2]
+    });
+    b["dmax"] = serde_json::json!(2);
+    let model = model(&json);
+    let ctx = Context::new(&model, None).unwrap();
+    let variant = balanced_variant(&model, &["m1", "K10"]);
+    let options = OptimiseOptions::default();
+    let run = new_run(&ctx, &variant, &options);
+    let problem = run.problem.as_ref().unwrap();
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &[0, 1]);
+    let search = |max_nodes: usize| {
+        let branch = BranchOptions {
+            gap_tolerance: options.gap_tolerance,
+            max_nodes,
+            solver_iterations: options.solver_iterations,
+        };
+        let b = &ctx.basis.unbalanced;
+        branch_and_bound(problem, b, &tasks, options.objective, &branch, None, None)
+            .unwrap()
+            .0
+    };
+    let Verdict::Impossible { nodes: needed } = search(100_000) else {
+        panic!("m1 + K10 within these bounds must be proved impossible");
+    };
+    assert!(needed >= 2, "the proof needs {needed} boxes");
+    let quarter = needed.div_ceil(crate::certify::NO_DESIGN_BUDGET_FACTOR);
+    assert!(quarter < needed);
+    assert!(
+        matches!(search(quarter), Verdict::Impossible { nodes } if nodes == needed),
+        "a limit of {quarter} boxes (× 4 = {}) must still prove it",
+        4 * quarter
+    );
+    if needed >= 6 {
+        let short = (needed - 3) / crate::certify::NO_DESIGN_BUDGET_FACTOR;
+        assert!(
+            matches!(
+                search(short),
+                Verdict::Stopped { design: None, nodes, .. } if nodes < needed
+            ),
+            "a limit of {short} boxes (× 4 < {needed}) must stop before the proof"
+        );
+    }
+}
