@@ -79,6 +79,27 @@ fn two_link_counterweights() -> (Model, Context, VariantResult) {
     (model, ctx, variant)
 }
 
+/// The pendulum's variant m1 + K10 at Dmax 2: a counterweight of at most `max_mass` kg within
+/// 1 m (a cylinder when `cylinder`, else a point mass) and a spring K10 to the base of
+/// 1–100 N/m between anchors within 0.3 m and 0.2 m (at most 6 N·m of the rod's 9.81).
+fn pendulum_m1_k10(max_mass: f64, cylinder: bool) -> (Model, Context, VariantResult) {
+    let mut json = case_json("pendulum.json");
+    let b = &mut json["balancing"];
+    b["bounds"] = serde_json::json!({
+        "mass": [0.0, max_mass], "radius": [0.0, 1.0],
+        "stiffness": [1.0, 100.0], "anchor_a": [0.0, 0.3], "anchor_b": [0.0, 0.2]
+    });
+    if cylinder {
+        b["counterweights"]["shape"] =
+            serde_json::json!({ "cylinder": { "radius_to_thickness": 0.5, "density": 7850.0 } });
+    }
+    b["dmax"] = serde_json::json!(2);
+    let model = model(&json);
+    let ctx = Context::new(&model, None).unwrap();
+    let variant = balanced_variant(&model, &["m1", "K10"]);
+    (model, ctx, variant)
+}
+
 /// Largest violation of the bounds (mass range, |μ| ≤ r_hi·m) at the lifted point `x` of the
 /// two-link family, written from the case's bounds by hand: ≤ 0 inside.
 fn two_link_bound_violation(problem: &VariantProblem, x: &DVector<f64>) -> f64 {
@@ -365,18 +386,7 @@ fn a_search_resumed_on_more_tasks_ends_where_a_fresh_one_does() {
     // The pendulum with a counterweight m1 and a spring K10 to the base that can carry only
     // 100 · 0.3 · 0.2 = 6 of the rod's 9.81 N·m: the search must split the anchors and the
     // counterweight (the certified-stage tests' hybrid case).
-    let mut json = case_json("pendulum.json");
-    let b = &mut json["balancing"];
-    b["bounds"] = serde_json::json!({
-        "mass": [0.0, 5.0], "radius": [0.0, 1.0],
-        "stiffness": [1.0, 100.0], "anchor_a": [0.0, 0.3], "anchor_b": [0.0, 0.2]
-    });
-    b["counterweights"]["shape"] =
-        serde_json::json!({ "cylinder": { "radius_to_thickness": 0.5, "density": 7850.0 } });
-    b["dmax"] = serde_json::json!(2);
-    let model = model(&json);
-    let ctx = Context::new(&model, None).unwrap();
-    let variant = balanced_variant(&model, &["m1", "K10"]);
+    let (_, ctx, variant) = pendulum_m1_k10(5.0, true);
     let options = OptimiseOptions::default();
     let run = new_run(&ctx, &variant, &options);
     let problem = run.problem.as_ref().unwrap();
@@ -437,16 +447,7 @@ fn a_search_resumed_on_more_tasks_ends_where_a_fresh_one_does() {
 /// 0.2 m (6 N·m) cannot carry the rod's 9.81 N·m (by hand: 6.98 < 9.81).
 #[test]
 fn a_search_without_a_design_has_four_times_the_box_budget() {
-    let mut json = case_json("pendulum.json");
-    let b = &mut json["balancing"];
-    b["bounds"] = serde_json::json!({
-        "mass": [0.0, 0.1], "radius": [0.0, 1.0],
-        "stiffness": [1.0, 100.0], "anchor_a": [0.0, 0.3], "anchor_b": [0.0, 0.2]
-    });
-    b["dmax"] = serde_json::json!(2);
-    let model = model(&json);
-    let ctx = Context::new(&model, None).unwrap();
-    let variant = balanced_variant(&model, &["m1", "K10"]);
+    let (_, ctx, variant) = pendulum_m1_k10(0.1, false);
     let options = OptimiseOptions::default();
     let run = new_run(&ctx, &variant, &options);
     let problem = run.problem.as_ref().unwrap();
