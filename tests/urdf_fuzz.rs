@@ -15,53 +15,22 @@
 //! prints the counts (`URDF_FUZZ_SEED` picks another sequence).
 
 use std::path::Path;
-use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+
+mod common;
+use common::process::{Ran, run_binary};
 
 use counterpoise::model::sampling::SplitMix64;
 
 /// Longest one case may take (import and the three commands), generous for a loaded machine.
 const BUDGET: Duration = Duration::from_secs(20);
 
-/// How one run of the binary ended.
-enum Ran {
-    Exited(i32, String),
-    Signalled(String),
-    Hung,
-}
-
-/// Runs the binary until `deadline` (killed past it); standard output dropped, standard error
-/// to a file so that no pipe can fill and stall the child.
-fn run_binary(args: &[&str], dir: &Path, deadline: Instant) -> Ran {
-    let err_path = dir.join("stderr");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_counterpoise"))
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(std::fs::File::create(&err_path).unwrap())
-        .spawn()
-        .expect("the binary runs");
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status;
-        }
-        if Instant::now() >= deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Ran::Hung;
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    };
-    let stderr = std::fs::read_to_string(&err_path).unwrap_or_default();
-    match status.code() {
-        Some(code) => Ran::Exited(code, stderr),
-        None => Ran::Signalled(format!("{status:?}: {stderr}")),
-    }
-}
-
 /// Exit 0, or 1/2 with a message on stderr; anything else is a failure, described.
 fn answer(ran: Ran) -> Result<i32, String> {
     match ran {
-        Ran::Hung => Err(format!("no answer within {BUDGET:?}")),
+        Ran::Hung(used) => Err(format!(
+            "no answer within {BUDGET:?} (processor time used: {used:?})"
+        )),
         Ran::Signalled(what) => Err(format!("ended by a signal ({what})")),
         Ran::Exited(_, e) if e.contains("panicked") => Err(format!("panic: {e}")),
         Ran::Exited(code, e) if !(0..=2).contains(&code) => Err(format!("exit {code}: {e}")),
