@@ -185,6 +185,24 @@ pub fn find_witness(
     entries: &[(usize, &CatalogueEntry)],
     hints: RealizationHints,
 ) -> Result<Witness, String> {
+    find_witness_on(solution, b, entries, hints, &[])
+}
+
+/// [`find_witness`] with anchor components held at zero: `zero_columns` lists lifted columns of
+/// the variant, and each that is a spring's `α_i` (or `β_j`) holds its anchor's `a_i` (`b_j`) at
+/// exactly zero; other columns (`W`, masses) are ignored. A branch of the rank-one case split
+/// ([`crate::exact::split`]) is such a family: its extra equations `α_I = 0`, `W_I· = 0` only
+/// restrict the lifted solution set, which the search in physical variables never sees, and a
+/// search left free to place `a_I` has to creep onto the cancellation of the cross terms
+/// `K·a_I·b_Jᵀ` (the three-chain leg's five undecided sets stalled at residuals 4e-7–3e-4).
+/// Held at zero, those terms vanish identically and the rest is the easy part.
+pub fn find_witness_on(
+    solution: &LinearSolution,
+    b: &DVector<f64>,
+    entries: &[(usize, &CatalogueEntry)],
+    hints: RealizationHints,
+    zero_columns: &[usize],
+) -> Result<Witness, String> {
     let mut slots = Vec::new();
     let mut unknowns = 0;
     for (k, (entry_index, entry)) in entries.iter().enumerate() {
@@ -196,12 +214,14 @@ pub fn find_witness(
         });
         unknowns += physical_len(&entry.element);
     }
+    let held = held_unknowns(&slots, unknowns, zero_columns);
     let problem = Problem {
         hints,
         matrix: &solution.matrix,
         b,
         slots: &slots,
         unknowns,
+        held: &held,
     };
 
     // Fixed seed: starting points must not depend on thread count or on run.
@@ -231,6 +251,24 @@ pub fn find_witness(
             "no physical parameters found from {STARTS} starts (best relative residual {best:.2e})"
         ),
     })
+}
+
+/// Which physical unknowns are held at zero: the anchor components whose lifted `α_i`, `β_j`
+/// columns are in `zero_columns` (a spring's lifted `K, α, β` and physical `K, a, b` share one
+/// layout).
+fn held_unknowns(slots: &[Slot], unknowns: usize, zero_columns: &[usize]) -> Vec<bool> {
+    let mut held = vec![false; unknowns];
+    for slot in slots {
+        let Element::Spring { axes_a, axes_b, .. } = &slot.entry.element else {
+            continue;
+        };
+        for t in 0..axes_a.len() + axes_b.len() {
+            if zero_columns.contains(&(slot.column + 1 + t)) {
+                held[slot.unknown + 1 + t] = true;
+            }
+        }
+    }
+    held
 }
 
 /// The first mass or stiffness of the witness below its floor, described.
@@ -399,6 +437,8 @@ struct Problem<'a> {
     b: &'a DVector<f64>,
     slots: &'a [Slot<'a>],
     unknowns: usize,
+    /// Unknowns held at zero (their Jacobian columns are zero, so no step moves them).
+    held: &'a [bool],
 }
 
 impl Problem<'_> {
@@ -492,6 +532,9 @@ impl Problem<'_> {
                 }
             }
         }
+        for (j, _) in self.held.iter().enumerate().filter(|(_, h)| **h) {
+            jac.column_mut(j).fill(0.0);
+        }
         (r, jac)
     }
 
@@ -535,6 +578,9 @@ impl Problem<'_> {
                     }
                 }
             }
+        }
+        for (j, _) in self.held.iter().enumerate().filter(|(_, h)| **h) {
+            y[j] = 0.0;
         }
         y
     }

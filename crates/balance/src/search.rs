@@ -10,7 +10,9 @@ use crate::energy::MechanismEnergy;
 use crate::enumerate::variants;
 use crate::exact::{ExactBasis, ExactField, ExactSolution, positivity, rank_one, split};
 use crate::linear::{LiftedBasis, solve};
-use crate::realize::{Realization, RealizationHints, Witness, find_witness, realize};
+use crate::realize::{
+    Realization, RealizationHints, Witness, find_witness, find_witness_on, realize,
+};
 use crate::relations::{
     AdmissibleRange, FreeDirection, admissible_ranges, balance_relations, exact_relations,
     free_directions, variable_units,
@@ -380,7 +382,11 @@ fn decide_exact<F: ExactField>(
                     if linear.ensure_finite().is_err() {
                         continue;
                     }
-                    if let Ok(w) = find_witness(&linear, &numeric.unbalanced, entries, hints) {
+                    // The branch's anchor parts are zero: hold them there in the search.
+                    let zero = unit_columns(rows);
+                    let found =
+                        find_witness_on(&linear, &numeric.unbalanced, entries, hints, &zero);
+                    if let Ok(w) = found {
                         return accept_witness(checks, w, result);
                     }
                 }
@@ -399,6 +405,22 @@ fn decide_exact<F: ExactField>(
     }
     result.status = Status::Undecided;
     result.reason = Some(witness);
+}
+
+/// The variables that extra rows of the form `x_j = 0` (a split branch's) set to zero.
+fn unit_columns<F: ExactField>(rows: &[Vec<F>]) -> Vec<usize>
+where
+    for<'a> &'a F: RefArith<F>,
+{
+    rows.iter()
+        .filter_map(|row| {
+            let mut nonzero = row.iter().enumerate().filter(|(_, v)| !v.is_zero());
+            match (nonzero.next(), nonzero.next()) {
+                (Some((j, _)), None) => Some(j),
+                _ => None,
+            }
+        })
+        .collect()
 }
 
 /// Proofs of unrealizability from signs, in exact arithmetic: a mass or stiffness fixed at zero

@@ -253,3 +253,91 @@ fn the_spherical_chain_is_decided_with_nothing_undecided() {
     // The 110 infeasible sets and the balanced ones at least are decided numerically too.
     assert!(compared >= 120, "only {compared} numeric verdicts");
 }
+
+/// The leg's potential energy written out by hand from the case file, independent of the
+/// crate's formulas: chain k's frame has origin `p_k = 0.3·(cos θ_k, sin θ_k, 0)` and rotation
+/// `R_k = R_z(θ_k)·R_y(q_k)` (θ = 0, 120°, −120°), its link 1.2 kg at (0.25, 0, 0); gravity
+/// 9.81 along −z; a counterweight adds `m g z`, a spring `K/2·|p_i + R_i a − p_j − R_j b|²` (the
+/// base: `p = 0`, `R = I`).
+fn leg_energy(witness: &counterpoise_balance::Witness, q: &[f64; 3]) -> f64 {
+    use counterpoise_balance::Attachment;
+    let theta = [
+        0.0,
+        2.0 * std::f64::consts::PI / 3.0,
+        -2.0 * std::f64::consts::PI / 3.0,
+    ];
+    let frame = |k: usize, x: [f64; 3]| -> [f64; 3] {
+        let (sq, cq) = q[k].sin_cos();
+        // R_y(q): (x, y, z) ↦ (x cos q + z sin q, y, −x sin q + z cos q).
+        let (u, v, w) = (x[0] * cq + x[2] * sq, x[1], -x[0] * sq + x[2] * cq);
+        let (st, ct) = theta[k].sin_cos();
+        [0.3 * ct + u * ct - v * st, 0.3 * st + u * st + v * ct, w]
+    };
+    let g = 9.81;
+    let mut energy: f64 = (0..3)
+        .map(|k| 1.2 * g * frame(k, [0.25, 0.0, 0.0])[2])
+        .sum();
+    for c in &witness.counterweights {
+        energy += c.mass * g * frame(c.body, c.offset)[2];
+    }
+    for s in &witness.springs {
+        let a = frame(s.body, s.anchor_a);
+        let b = match s.other {
+            Attachment::Base => s.anchor_b,
+            Attachment::Body(j) => frame(j, s.anchor_b),
+        };
+        let d2: f64 = (0..3).map(|i| (a[i] - b[i]).powi(2)).sum();
+        energy += 0.5 * s.stiffness * d2;
+    }
+    energy
+}
+
+/// The five sets with springs between chains that the witness search once left undecided
+/// (`m1 + K21 + K31`, …) are realizable, by hand: a spring whose anchor sits on another chain's
+/// joint axis (a point that never moves) acts on its own chain like a base spring, and a base
+/// spring balances a pendulum (`−K·d·a_z = m g 0.25` with `d` the anchor's horizontal offset).
+/// E.g. m3 + K31 + K32: K31 and K32 anchored on chain 3's axis balance chains 1 and 2, m3
+/// balances chain 3. Each must end balanced with a witness whose energy, evaluated by
+/// [`leg_energy`] at random poses, is constant to 1e-9 of the unbalanced energy's spread; and
+/// the whole leg at Dmax 3 leaves nothing undecided.
+#[test]
+fn the_leg_s_inter_chain_sets_are_realized_by_anchors_on_a_joint_axis() {
+    let report = run(&model_of(&leg_json()), 3);
+    let undecided: Vec<_> = report
+        .variants
+        .iter()
+        .filter(|v| v.status == Status::Undecided)
+        .map(|v| (labels(v), v.reason.clone()))
+        .collect();
+    assert!(undecided.is_empty(), "{undecided:?}");
+    let mut rng = SplitMix64::new(120);
+    let poses: Vec<[f64; 3]> = (0..64)
+        .map(|_| std::array::from_fn(|_| rng.uniform(-1.5, 1.5)))
+        .collect();
+    let bare = counterpoise_balance::Witness::default();
+    let spread = |f: &dyn Fn(&[f64; 3]) -> f64| {
+        let values: Vec<f64> = poses.iter().map(f).collect();
+        let max = values.iter().cloned().fold(f64::MIN, f64::max);
+        let min = values.iter().cloned().fold(f64::MAX, f64::min);
+        max - min
+    };
+    let unbalanced = spread(&|q| leg_energy(&bare, q));
+    assert!(unbalanced > 1.0, "{unbalanced}"); // 2.94 J amplitude per chain
+    for set in [
+        ["m1", "K21", "K31"],
+        ["m2", "K21", "K32"],
+        ["m2", "K31", "K32"],
+        ["m3", "K31", "K32"],
+        ["K10", "K21", "K31"],
+    ] {
+        let v = find(&report, &set);
+        assert_eq!(v.status, Status::Balanced, "{set:?}: {:?}", v.reason);
+        let w = v
+            .witness
+            .as_ref()
+            .expect("a balanced variant has a witness");
+        assert_eq!(w.counterweights.len() + w.springs.len(), 3);
+        let left = spread(&|q| leg_energy(w, q));
+        assert!(left <= 1e-9 * unbalanced, "{set:?}: spread {left:e} J");
+    }
+}
