@@ -7,8 +7,8 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use counterpoise_balance::minimal::{MinimalReport, estimate_tested, minimal_search};
 use counterpoise_balance::{
-    Attachment, Catalogue, Class, Decision, SearchOptions, SearchReport, Status, VariantResult,
-    catalogue_options, mechanism_energy, realization_hints, search,
+    Arithmetic, Attachment, Catalogue, Class, Decision, SearchOptions, SearchReport, Status,
+    VariantResult, catalogue_options, mechanism_energy, realization_hints, search,
 };
 use counterpoise_model::limits::{Limit, format_count};
 use counterpoise_model::{Model, ModelError, Plane};
@@ -94,6 +94,7 @@ pub fn to_json(
         "dmax": dmax,
         "seconds": seconds,
         "catalogue": catalogue,
+        "field": report.arithmetic,
         "counts": counts,
         "variants": report.variants,
     })
@@ -169,22 +170,30 @@ pub fn witness_lines(model: &Model, v: &VariantResult) -> Vec<String> {
     lines
 }
 
-/// Which arithmetic decided the variants, in one line.
+/// Which arithmetic decided the variants, in one line: the exact field by name (a case over
+/// ℚ(√2, √3) is not "rational"), or floating point and how many variants were still exact.
 fn decision_line(report: &SearchReport) -> String {
     let exact = report
         .variants
         .iter()
         .filter(|v| v.decision == Decision::Exact)
         .count();
-    if exact == report.variants.len() {
-        "decided in exact rational arithmetic\n".to_string()
-    } else {
-        format!(
+    match report.arithmetic {
+        Arithmetic::Rational if exact == report.variants.len() => {
+            "decided in exact rational arithmetic (over ℚ: every number of the case is rational)\n"
+                .to_string()
+        }
+        Arithmetic::Surd if exact == report.variants.len() => {
+            "decided in exact arithmetic over ℚ(√2, √3) (numbers q₀ + q₁√2 + q₂√3 + q₃√6 with \
+             rational qᵢ: the case rotates by multiples of π/12; see `check`)\n"
+                .to_string()
+        }
+        _ => format!(
             "decided in floating point with an ambiguous zone ({} of {} exactly): the case has an \
              irrational constant (see `check`)\n",
             exact,
             report.variants.len()
-        )
+        ),
     }
 }
 
@@ -541,4 +550,37 @@ pub fn minimal_tables(model: &Model, dmax: usize, report: &MinimalReport, second
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(arithmetic: Arithmetic) -> SearchReport {
+        SearchReport {
+            catalogue: Catalogue {
+                entries: Vec::new(),
+            },
+            variants: Vec::new(),
+            arithmetic,
+        }
+    }
+
+    /// The line names the field the search used: a case decided over ℚ(√2, √3) (the three-chain
+    /// leg at 120°) was once said to be decided "in exact rational arithmetic".
+    #[test]
+    fn the_decision_line_names_the_field() {
+        let surd = decision_line(&report(Arithmetic::Surd));
+        assert!(surd.contains("exact arithmetic over ℚ(√2, √3)"), "{surd}");
+        assert!(!surd.contains("rational arithmetic"), "{surd}");
+        let rational = decision_line(&report(Arithmetic::Rational));
+        assert!(rational.starts_with("decided in exact rational arithmetic (over ℚ"));
+        let float = decision_line(&report(Arithmetic::Float));
+        assert!(float.starts_with("decided in floating point"), "{float}");
+        // The JSON names it too, in ASCII.
+        assert_eq!(
+            serde_json::to_value(Arithmetic::Surd).unwrap(),
+            json!("Q(sqrt2,sqrt3)")
+        );
+    }
 }

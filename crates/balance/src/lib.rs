@@ -37,6 +37,6 @@ pub use energy::{BodyFrame, MechanismEnergy};
 pub use model_input::{catalogue_options, mechanism_energy, realization_hints};
 pub use realize::{CounterweightParams, RealizationHints, SpringParams, Witness};
 pub use search::{
-    Class, Decision, SearchOptions, SearchReport, Status, VariantResult, decide, search,
+    Arithmetic, Class, Decision, SearchOptions, SearchReport, Status, VariantResult, decide, search,
 };
 pub use verify::{VERIFY_SAMPLES, VERIFY_TOL, Verification, VerificationSet};

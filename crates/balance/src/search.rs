@@ -169,11 +169,47 @@ pub struct SearchOptions {
     pub hints: RealizationHints,
 }
 
-/// The search's output: the catalogue and every variant in enumeration order.
+/// The field a case's variants are decided in: the first of ℚ, ℚ(√2, √3) and floating point
+/// that holds every constant of the case (the same for all its variants). A variant's
+/// [`Decision`] only says exact or numeric; this says which exact field, so that output can name
+/// it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Arithmetic {
+    #[serde(rename = "Q")]
+    Rational,
+    #[serde(rename = "Q(sqrt2,sqrt3)")]
+    Surd,
+    #[serde(rename = "float")]
+    Float,
+}
+
+impl Arithmetic {
+    /// The field the search takes for this basis (the order of [`decide`]).
+    pub fn of(basis: &LiftedBasis) -> Arithmetic {
+        match (&basis.exact, &basis.surd) {
+            (Some(_), _) => Arithmetic::Rational,
+            (None, Some(_)) => Arithmetic::Surd,
+            (None, None) => Arithmetic::Float,
+        }
+    }
+
+    /// The field's name for people: `ℚ`, `ℚ(√2, √3)`, `floating point`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Arithmetic::Rational => "ℚ",
+            Arithmetic::Surd => "ℚ(√2, √3)",
+            Arithmetic::Float => "floating point",
+        }
+    }
+}
+
+/// The search's output: the catalogue, every variant in enumeration order, and the field they
+/// were decided in.
 #[derive(Clone, Debug)]
 pub struct SearchReport {
     pub catalogue: Catalogue,
     pub variants: Vec<VariantResult>,
+    pub arithmetic: Arithmetic,
 }
 
 impl SearchReport {
@@ -205,6 +241,7 @@ pub fn search(
         .map(|set| decide(energy, &catalogue, &basis, &checks, set, options.hints))
         .collect();
     SearchReport {
+        arithmetic: Arithmetic::of(&basis),
         catalogue,
         variants,
     }
