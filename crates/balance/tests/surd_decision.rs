@@ -116,10 +116,48 @@ fn a_spring_between_two_chains_cannot_balance_both() {
 /// with m·r_x = −0.3 kg·m, m·r_z = 0 (the √2/2 divides out).
 #[test]
 fn a_chain_at_45_degrees_is_exact_over_the_surd_field() {
+    check_tilted_chain("pi/4");
+}
+
+/// The same chain with its tilt written `atan2(1, 1)`, and as `atan2` of field numbers
+/// (`atan2(2*sin(pi/4), 2*cos(pi/4))` = atan2(√2, √2)): the same angle π/4 by hand, so the same
+/// exact decision and relations.
+#[test]
+fn a_tilt_written_as_atan2_of_field_numbers_is_exact() {
+    check_tilted_chain("atan2(1, 1)");
+    check_tilted_chain("atan2(2*sin(pi/4), 2*cos(pi/4))");
+}
+
+/// A tilt whose cosine is outside ℚ(√2, √3), `atan2(1, 2)` (cos = 2/√5), takes the numeric path
+/// with a reason naming the pose and the field.
+#[test]
+fn a_tilt_outside_the_field_is_refused_naming_the_field() {
+    // R_x(t)·(0, 1, 0) = (0, cos t, sin t) ∥ (0, 2, 1).
+    let model = model_of(&tilted_chain_about(
+        "atan2(1, 2)",
+        serde_json::json!([0, 2, 1]),
+    ));
+    let energy = mechanism_energy(&model);
+    let reason = energy.surd.as_ref().unwrap_err();
+    assert!(reason.starts_with("bodies[0].pose"), "{reason}");
+    assert!(
+        reason.contains("ℚ(√2, √3)") && reason.contains("√(5)"),
+        "{reason}"
+    );
+    assert_eq!(run(&model, 1).variants[0].decision, Decision::Numeric);
+}
+
+/// One link tilted by `tilt` about x, then turning about its y axis; the joint axis is given for
+/// a tilt of π/4 unless `axis` says otherwise.
+fn tilted_chain(tilt: &str) -> serde_json::Value {
+    tilted_chain_about(tilt, serde_json::json!([0, "cos(pi/4)", "sin(pi/4)"]))
+}
+
+fn tilted_chain_about(tilt: &str, axis: serde_json::Value) -> serde_json::Value {
     let mut case = leg_json();
     case["bodies"] = serde_json::json!([
         { "name": "link1", "parent": "base",
-          "pose": [ { "rot_x": "pi/4" }, { "rot_y": "q1" } ],
+          "pose": [ { "rot_x": tilt }, { "rot_y": "q1" } ],
           "mass": 1.2, "com": [0.25, 0, 0], "inertia": [0.001, 0.01, 0.01, 0, 0, 0] }
     ]);
     case["coordinates"] = serde_json::json!([
@@ -127,12 +165,16 @@ fn a_chain_at_45_degrees_is_exact_over_the_surd_field() {
     ]);
     case["joints"] = serde_json::json!([
         { "name": "J1", "kind": "revolute", "bodies": ["base", "link1"], "point": [0, 0, 0],
-          "axis": [0, "cos(pi/4)", "sin(pi/4)"] }
+          "axis": axis }
     ]);
     case["actuators"] = serde_json::json!([
         { "name": "M1", "joint": "J1", "coordinate": "q1", "ratio": 0.01 }
     ]);
-    let model = model_of(&case);
+    case
+}
+
+fn check_tilted_chain(tilt: &str) {
+    let model = model_of(&tilted_chain(tilt));
     let energy = mechanism_energy(&model);
     assert!(energy.exact.is_err());
     assert!(energy.surd.is_ok());

@@ -4,18 +4,29 @@
 //! ℚ constant of [`ExactConstant`] with its plain part widened, so that `cos(pi/6)` written in a
 //! case is a number like any other. A rotation angle is exact when its plain part is zero, its
 //! π part a multiple of 1/12 (every sum of multiples of π/6 and π/4 is one) and its `atan2` part
-//! an integer combination of rational rotations; its cosine and sine then lie in the field.
+//! an integer combination of rotations whose cosine and sine lie in the field; its own cosine and
+//! sine then lie in the field.
+//!
+//! `atan2(y, x)` of field numbers is exact exactly when the hypotenuse `√(x² + y²)` lies in the
+//! field (the cosine is `x` over it): `atan2(1, 1)` is π/4 and `atan2(2*sin(pi/3), 1)` is π/3
+//! (found as twelfth turns, so they print and add as such; see [`surd_atan2`]), `atan2(1, sqrt 2)`
+//! a rotation with cosine √3/3; `atan2(1, 2)` (cosine 2/√5) is refused with the reason.
 
 use crate::field::{ExactConstant, Field};
 use crate::scalar::{Rational, Scalar};
 use crate::surd::Surd;
 
-/// `value + angle`, `angle` being an [`ExactConstant`] without plain part (`π` and `atan2`
-/// multiples only).
+/// A rotation `(cos, sin)` with both in ℚ(√2, √3) and `cos² + sin² = 1`.
+pub type SurdRotation = (Surd, Surd);
+
+/// `value + angle + Σ n·turn`: `angle` an [`ExactConstant`] without plain part (`π` and
+/// rational `atan2` multiples only), `turns` the field rotations that are neither (from
+/// `atan2` of field numbers) with their multiples.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SurdConstant {
     pub value: Surd,
     pub angle: ExactConstant,
+    pub turns: Vec<(SurdRotation, Rational)>,
 }
 
 impl SurdConstant {
@@ -23,12 +34,27 @@ impl SurdConstant {
         SurdConstant {
             value,
             angle: Rational::zero_constant(),
+            turns: Vec::new(),
         }
+    }
+
+    /// A pure angle: `π` and rational rotations.
+    fn angle(angle: ExactConstant) -> SurdConstant {
+        SurdConstant {
+            value: Surd::zero(),
+            angle,
+            turns: Vec::new(),
+        }
+    }
+
+    /// Whether the constant has an angle part (π, `atan2`).
+    fn has_angle(&self) -> bool {
+        self.angle != Rational::zero_constant() || !self.turns.is_empty()
     }
 
     /// The constant when it has no π or atan2 part.
     fn as_value(&self) -> Option<&Surd> {
-        (self.angle == Rational::zero_constant()).then_some(&self.value)
+        (!self.has_angle()).then_some(&self.value)
     }
 }
 
@@ -54,6 +80,75 @@ fn twelfth_turns(k: i64) -> (Surd, Surd) {
     out
 }
 
+/// `(c + i s)^n` for an integer `n` (negative: the conjugate), in the field.
+fn turn_power(r: &SurdRotation, n: i64) -> SurdRotation {
+    let (c, s) = r;
+    let s = if n < 0 { -s.clone() } else { s.clone() };
+    let mut out = (Surd::one(), Surd::zero());
+    for _ in 0..n.unsigned_abs() {
+        out = (&out.0 * c - &out.1 * &s, &out.0 * &s + &out.1 * c);
+    }
+    out
+}
+
+/// `atan2(y, x)` for `(x, y) ≠ 0` in ℚ(√2, √3), when its cosine and sine lie in the field.
+///
+/// First as `k·π/12`, or `k·π/12` plus a rotation with rational cosine and sine: `(x, y)` turned
+/// back by `k·π/12` points along the positive x axis, or along a rational direction `(1, t)`
+/// with `1 + t²` a rational square. The turn is exact and the signs are decided exactly
+/// ([`Surd::signum`]), so `atan2(1, 1)` is π/4 and `atan2(2*sin(pi/3), 1)` is π/3, not doubles
+/// near them. Otherwise, when the hypotenuse `√(x² + y²)` lies in the field ([`Surd::sqrt`]), the
+/// rotation `(x, y)/√(x² + y²)` itself. `None` when it does not (`atan2(1, 2)`: √5), and for
+/// `(0, 0)`.
+fn surd_atan2(y: &Surd, x: &Surd) -> Option<SurdConstant> {
+    let twelfths = |k: i64| {
+        let angle = Rational::mul_constants(
+            &Rational::from_scalar(Rational::new(k.into(), 12.into())),
+            &Rational::pi(),
+        )
+        .expect("a rational multiple of π");
+        SurdConstant::angle(angle)
+    };
+    // (x, y) turned by −k·π/12.
+    let turned: Vec<(i64, Surd, Surd)> = (0..24)
+        .map(|k| {
+            let (c, s) = twelfth_turns(k);
+            (k, &c * x + &s * y, &c * y - &s * x)
+        })
+        .collect();
+    if let Some((k, _, _)) = turned
+        .iter()
+        .find(|(_, u, v)| v.is_zero() && u.signum() > 0)
+    {
+        return Some(twelfths(*k));
+    }
+    let lattice = turned.iter().find_map(|(k, u, v)| {
+        if u.signum() <= 0 {
+            return None;
+        }
+        let t = (v * &u.inverse()?).as_rational()?.clone();
+        let rotation = Rational::atan2(
+            &Rational::from_scalar(t),
+            &Rational::from_scalar(Rational::one()),
+        )
+        .ok()?;
+        Some(Surd::add_constants(
+            &twelfths(*k),
+            &SurdConstant::angle(rotation),
+        ))
+    });
+    if lattice.is_some() {
+        return lattice;
+    }
+    let hypotenuse = (x * x + y * y).sqrt()?;
+    let inverse = hypotenuse.inverse()?;
+    Some(SurdConstant {
+        value: Surd::zero(),
+        angle: Rational::zero_constant(),
+        turns: vec![((x * &inverse, y * &inverse), Rational::one())],
+    })
+}
+
 impl Field for Surd {
     type Constant = SurdConstant;
 
@@ -67,36 +162,51 @@ impl Field for Surd {
         SurdConstant::plain(Surd::zero())
     }
     fn pi() -> SurdConstant {
-        SurdConstant {
-            value: Surd::zero(),
-            angle: Rational::pi(),
-        }
+        SurdConstant::angle(Rational::pi())
     }
     fn from_scalar(c: Surd) -> SurdConstant {
         SurdConstant::plain(c)
     }
     fn constant_value(c: &SurdConstant) -> f64 {
-        c.value.to_f64() + Rational::constant_value(&c.angle)
+        let turns: f64 = c
+            .turns
+            .iter()
+            .map(|((cos, sin), n)| n.to_f64() * sin.to_f64().atan2(cos.to_f64()))
+            .sum();
+        c.value.to_f64() + Rational::constant_value(&c.angle) + turns
     }
     fn add_constants(a: &SurdConstant, b: &SurdConstant) -> SurdConstant {
+        let mut turns = a.turns.clone();
+        for (turn, n) in &b.turns {
+            match turns.iter_mut().find(|(t, _)| t == turn) {
+                Some((_, m)) => *m = &*m + n,
+                None => turns.push((turn.clone(), n.clone())),
+            }
+        }
+        turns.retain(|(_, n)| !n.is_zero());
         SurdConstant {
             value: &a.value + &b.value,
             angle: Rational::add_constants(&a.angle, &b.angle),
+            turns,
         }
     }
     fn mul_constants(a: &SurdConstant, b: &SurdConstant) -> Result<SurdConstant, String> {
         let scale = |v: &Surd, c: &SurdConstant| -> Result<SurdConstant, String> {
-            let angle = if c.angle == Rational::zero_constant() {
-                c.angle.clone()
-            } else {
-                let q = v.as_rational().ok_or_else(|| {
-                    "not exact: an angle (π or atan2) times an irrational number".to_string()
-                })?;
-                Rational::mul_constants(&Rational::from_scalar(q.clone()), &c.angle)?
-            };
+            if !c.has_angle() {
+                return Ok(SurdConstant::plain(v * &c.value));
+            }
+            let q = v.as_rational().ok_or_else(|| {
+                "not exact: an angle (π or atan2) times an irrational number".to_string()
+            })?;
             Ok(SurdConstant {
                 value: v * &c.value,
-                angle,
+                angle: Rational::mul_constants(&Rational::from_scalar(q.clone()), &c.angle)?,
+                turns: c
+                    .turns
+                    .iter()
+                    .map(|(t, n)| (t.clone(), n * q))
+                    .filter(|(_, n)| !n.is_zero())
+                    .collect(),
             })
         };
         match (a.as_value(), b.as_value()) {
@@ -130,15 +240,27 @@ impl Field for Surd {
         }
     }
     fn atan2(y: &SurdConstant, x: &SurdConstant) -> Result<SurdConstant, String> {
-        let rational = |c: &SurdConstant| {
+        let value = |c: &SurdConstant| {
             c.as_value()
-                .and_then(Surd::as_rational)
-                .map(|q| Rational::from_scalar(q.clone()))
-                .ok_or_else(|| "not exact: atan2 of irrational arguments".to_string())
+                .cloned()
+                .ok_or_else(|| "not exact: atan2 of an angle (π or atan2)".to_string())
         };
-        Ok(SurdConstant {
-            value: Surd::zero(),
-            angle: Rational::atan2(&rational(y)?, &rational(x)?)?,
+        let (y, x) = (value(y)?, value(x)?);
+        // Rational arguments with a rational hypotenuse: a rational rotation, as over ℚ.
+        if let (Some(qy), Some(qx)) = (y.as_rational(), x.as_rational())
+            && let Ok(angle) = Rational::atan2(
+                &Rational::from_scalar(qy.clone()),
+                &Rational::from_scalar(qx.clone()),
+            )
+        {
+            return Ok(SurdConstant::angle(angle));
+        }
+        surd_atan2(&y, &x).ok_or_else(|| {
+            format!(
+                "not exact: atan2({y}, {x}) has cosine x/√(x² + y²), and √(x² + y²) = √({}) \
+                 is not in ℚ(√2, √3) (nor is the angle a multiple of π/12)",
+                &x * &x + &y * &y
+            )
         })
     }
     fn to_scalar(c: &SurdConstant) -> Result<Surd, String> {
@@ -151,8 +273,8 @@ impl Field for Surd {
         if !c.value.is_zero() {
             return Err(format!(
                 "not exact: the angle constant {} rad has a transcendental cosine (write \
-                 multiples of pi/12, such as pi/6 or pi/4, or atan2(y, x) with a rational \
-                 hypotenuse)",
+                 multiples of pi/12, such as pi/6 or pi/4, or atan2(y, x) with x, y in the field \
+                 and √(x² + y²) too)",
                 c.value
             ));
         }
@@ -173,7 +295,21 @@ impl Field for Surd {
         };
         let (c1, s1) = Rational::cos_sin(&rotations)?;
         let (c1, s1) = (Surd::from_rational(c1), Surd::from_rational(s1));
-        Ok((&c0 * &c1 - &s0 * &s1, &c0 * &s1 + &s0 * &c1))
+        let mut out = (&c0 * &c1 - &s0 * &s1, &c0 * &s1 + &s0 * &c1);
+        for (turn, n) in &c.turns {
+            if !n.is_integer() {
+                return Err(format!(
+                    "not exact: a fractional multiple ({n}) of an atan2 rotation"
+                ));
+            }
+            let n = i64::try_from(n.to_integer())
+                .ok()
+                .filter(|n| n.abs() <= 64)
+                .ok_or_else(|| "not exact: an atan2 multiple beyond 64".to_string())?;
+            let (c2, s2) = turn_power(turn, n);
+            out = (&out.0 * &c2 - &out.1 * &s2, &out.0 * &s2 + &out.1 * &c2);
+        }
+        Ok(out)
     }
 }
 
@@ -268,6 +404,98 @@ mod tests {
                 Surd::new(q(2, 5), q(0, 1), q(3, 10), q(0, 1)),
             ))
         );
+    }
+
+    fn c(v: Surd) -> SurdConstant {
+        Surd::from_scalar(v)
+    }
+
+    fn r(n: i64, d: i64) -> Surd {
+        Surd::from_rational(q(n, d))
+    }
+
+    #[test]
+    fn atan2_of_field_numbers_is_a_twelfth_turn_by_hand() {
+        let root2_2 = Surd::new(q(0, 1), q(1, 2), q(0, 1), q(0, 1));
+        let root3_2 = Surd::new(q(0, 1), q(0, 1), q(1, 2), q(0, 1));
+        // atan2(1, 1) = π/4: the constant itself is π/4 (no rotation part), cos = sin = √2/2.
+        let quarter = Surd::atan2(&c(r(1, 1)), &c(r(1, 1))).unwrap();
+        assert_eq!(quarter, pi_times(1, 4));
+        assert_eq!(
+            Surd::cos_sin(&quarter),
+            Ok((root2_2.clone(), root2_2.clone()))
+        );
+        assert!((Surd::constant_value(&quarter) - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+        // atan2(√3, 1) = π/3: (1/2, √3/2).
+        let third = Surd::atan2(&c(Surd::sqrt3()), &c(r(1, 1))).unwrap();
+        assert_eq!(Surd::cos_sin(&third), Ok((r(1, 2), root3_2.clone())));
+        // atan2(−1, −√3) = −150°: (−√3/2, −1/2).
+        let third_quadrant = Surd::atan2(&c(r(-1, 1)), &c(-Surd::sqrt3())).unwrap();
+        assert_eq!(
+            Surd::cos_sin(&third_quadrant),
+            Ok((-root3_2.clone(), r(-1, 2)))
+        );
+        // atan2(1, 2 + √3) = 15° (tan 15° = 2 − √3 = 1/(2 + √3)): ((√6 + √2)/4, (√6 − √2)/4).
+        let two_plus_root3 = &r(2, 1) + &Surd::sqrt3();
+        let fifteen = Surd::atan2(&c(r(1, 1)), &c(two_plus_root3)).unwrap();
+        assert_eq!(
+            Surd::cos_sin(&fifteen),
+            Ok((
+                Surd::new(q(0, 1), q(1, 4), q(0, 1), q(1, 4)),
+                Surd::new(q(0, 1), q(-1, 4), q(0, 1), q(1, 4)),
+            ))
+        );
+        // On the axes: atan2(√2, 0) = π/2, atan2(0, −√3) = π.
+        let up = Surd::atan2(&c(Surd::sqrt2()), &c(r(0, 1))).unwrap();
+        assert_eq!(Surd::cos_sin(&up), Ok((r(0, 1), r(1, 1))));
+        let back = Surd::atan2(&c(r(0, 1)), &c(-Surd::sqrt3())).unwrap();
+        assert_eq!(Surd::cos_sin(&back), Ok((r(-1, 1), r(0, 1))));
+        // (−√2/2, 7√2/2) is (3, 4) turned by 45°: π/4 + atan2(4, 3), with
+        // cos = √2/2·3/5 − √2/2·4/5 = −√2/10 and sin = √2/2·(4/5 + 3/5) = 7√2/10.
+        let x = Surd::new(q(0, 1), q(-1, 2), q(0, 1), q(0, 1));
+        let y = Surd::new(q(0, 1), q(7, 2), q(0, 1), q(0, 1));
+        let mixed = Surd::atan2(&c(y), &c(x)).unwrap();
+        assert_eq!(
+            Surd::cos_sin(&mixed),
+            Ok((
+                Surd::new(q(0, 1), q(-1, 10), q(0, 1), q(0, 1)),
+                Surd::new(q(0, 1), q(7, 10), q(0, 1), q(0, 1)),
+            ))
+        );
+        // Rational arguments with a rational hypotenuse stay the rational rotation.
+        let rational = Surd::atan2(&c(r(4, 1)), &c(r(3, 1))).unwrap();
+        assert_eq!(Surd::cos_sin(&rational), Ok((r(3, 5), r(4, 5))));
+    }
+
+    #[test]
+    fn atan2_is_exact_when_the_hypotenuse_is_in_the_field_and_refused_otherwise() {
+        // cos atan2(1, 2) = 2/√5: not in ℚ(√2, √3).
+        let err = Surd::atan2(&c(r(1, 1)), &c(r(2, 1))).unwrap_err();
+        assert!(err.contains("ℚ(√2, √3)") && err.contains("√(5)"), "{err}");
+        assert!(err.contains("atan2(1, 2)"), "{err}");
+        // (1, √2): 54.7°, no twelfth turn (turned back by 45°, tan = 3 − 2√2 is irrational),
+        // but its hypotenuse √3 is in the field: cos = 1/√3 = √3/3, sin = √2/√3 = √6/3.
+        let tilted = Surd::atan2(&c(Surd::sqrt2()), &c(r(1, 1))).unwrap();
+        assert_eq!(
+            Surd::cos_sin(&tilted),
+            Ok((
+                Surd::new(q(0, 1), q(0, 1), q(1, 3), q(0, 1)),
+                Surd::new(q(0, 1), q(0, 1), q(0, 1), q(1, 3)),
+            ))
+        );
+        // Twice that angle: cos 2θ = 2/3 − 1 = −1/3, sin 2θ = 2·√3/3·√6/3 = 2√2/3.
+        let twice = Surd::mul_constants(&c(r(2, 1)), &tilted).unwrap();
+        assert_eq!(
+            Surd::cos_sin(&twice),
+            Ok((r(-1, 3), Surd::new(q(0, 1), q(2, 3), q(0, 1), q(0, 1))))
+        );
+        assert!((Surd::constant_value(&twice) - 2.0 * 2f64.sqrt().atan()).abs() < 1e-15);
+        // Half of it is refused where a rotation needs it.
+        let half = Surd::mul_constants(&c(r(1, 2)), &tilted).unwrap();
+        assert!(Surd::cos_sin(&half).unwrap_err().contains("fractional"));
+        // An angle as an argument.
+        let err = Surd::atan2(&Surd::pi(), &c(r(1, 1))).unwrap_err();
+        assert!(err.contains("angle"), "{err}");
     }
 
     #[test]

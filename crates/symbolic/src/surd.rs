@@ -94,6 +94,49 @@ impl Surd {
         }
     }
 
+    /// The non-negative square root when it lies in the field, `None` otherwise (or for a
+    /// negative number): `√(2 + √3) = (√6 + √2)/2`, `√3`, but not `√5` or `√(1 + √2)`.
+    ///
+    /// Write `x = A + B√3` with `A, B` in ℚ(√2) and look for `s = X + Y√3` with `X, Y` in ℚ(√2):
+    /// `X² + 3Y² = A` and `2XY = B` give `(X² − 3Y²)² = A² − 3B²`, so `C = X² − 3Y²` is a square
+    /// root of `A² − 3B²` in ℚ(√2), `X² = (A + C)/2` and then `Y = B/(2X)` (or, for `X = 0`,
+    /// `Y² = A/3`). ℚ(√2) is the same step once lower, over ℚ. Every candidate is squared back
+    /// before it is returned, so a root is never wrong, only possibly missed — and none is: the
+    /// steps are the complete case analysis of `s² = x`.
+    pub fn sqrt(&self) -> Option<Surd> {
+        if self.signum() < 0 {
+            return None;
+        }
+        let [a, b, c, d] = &self.q;
+        let zero = rational(0);
+        let big_a = Surd::new(a.clone(), b.clone(), zero.clone(), zero.clone());
+        let big_b = Surd::new(c.clone(), d.clone(), zero.clone(), zero.clone());
+        let discriminant = &(&big_a * &big_a) - &(&big_b * &big_b).scale(&rational(3));
+        let root = sqrt_in_q2(&discriminant)?;
+        let half = Rational::new(1.into(), 2.into());
+        for c in [root.clone(), -root] {
+            let x_squared = (&big_a + &c).scale(&half);
+            let candidate = if x_squared.is_zero_value() {
+                // X = 0: x = 3Y², a multiple of √3 in s.
+                sqrt_in_q2(&big_a.scale(&Rational::new(1.into(), 3.into())))
+                    .map(|y| Surd::new(zero.clone(), zero.clone(), y.q[0].clone(), y.q[1].clone()))
+            } else {
+                sqrt_in_q2(&x_squared).and_then(|x| {
+                    let y = &big_b * &x.scale(&rational(2)).inverse()?;
+                    Some(
+                        &x + &Surd::new(zero.clone(), zero.clone(), y.q[0].clone(), y.q[1].clone()),
+                    )
+                })
+            };
+            if let Some(s) = candidate
+                && &s * &s == *self
+            {
+                return Some(if s.signum() < 0 { -s } else { s });
+            }
+        }
+        None
+    }
+
     /// The exact sign: −1, 0 or 1.
     ///
     /// Write `x = u + v√3` with `u = q₀ + q₁√2`, `v = q₂ + q₃√2`. When `u` and `v` have the same
@@ -117,6 +160,33 @@ impl Surd {
         let r1 = &two * a * b - rational(6) * c * d;
         su * sign2(&r0, &r1)
     }
+}
+
+/// A square root in ℚ(√2) of `x = a + b√2` (`x` in ℚ(√2)), when there is one: `s = u + v√2`
+/// with `u² + 2v² = a`, `2uv = b`, so `u² − 2v² = ±√(a² − 2b²)` is rational, `u² = (a ± that)/2`,
+/// `v = b/(2u)` (or `v² = a/2` when `u = 0`). Checked by squaring back.
+fn sqrt_in_q2(x: &Surd) -> Option<Surd> {
+    let (a, b) = (&x.q[0], &x.q[1]);
+    let root = crate::scalar::rational_sqrt(&(a * a - rational(2) * b * b))?;
+    let zero = rational(0);
+    for c in [root.clone(), -root] {
+        let u_squared = (a + &c) / rational(2);
+        let candidate = if Zero::is_zero(&u_squared) {
+            crate::scalar::rational_sqrt(&(a / rational(2)))
+                .map(|v| Surd::new(zero.clone(), v, zero.clone(), zero.clone()))
+        } else {
+            crate::scalar::rational_sqrt(&u_squared).map(|u| {
+                let v = b / (rational(2) * &u);
+                Surd::new(u, v, zero.clone(), zero.clone())
+            })
+        };
+        if let Some(s) = candidate
+            && &s * &s == *x
+        {
+            return Some(s);
+        }
+    }
+    None
 }
 
 fn sign(q: &Rational) -> i32 {
@@ -340,6 +410,55 @@ mod tests {
 
     fn s(a: i64, b: i64, c: i64, d: i64) -> Surd {
         Surd::new(q(a, 1), q(b, 1), q(c, 1), q(d, 1))
+    }
+
+    #[test]
+    fn square_roots_in_the_field_by_hand() {
+        let half = q(1, 2);
+        // √(2 + √3) = (√6 + √2)/2: ((√6 + √2)/2)² = (6 + 2 + 2√12)/4 = 2 + √3.
+        assert_eq!(
+            s(2, 0, 1, 0).sqrt(),
+            Some(Surd::new(q(0, 1), half.clone(), q(0, 1), half.clone()))
+        );
+        // √(5 + 2√6) = √2 + √3; √(4 − 2√3) = √3 − 1 (positive root).
+        assert_eq!(s(5, 0, 0, 2).sqrt(), Some(s(0, 1, 1, 0)));
+        assert_eq!(s(4, 0, -2, 0).sqrt(), Some(s(-1, 0, 1, 0)));
+        // √3, √6, √8 = 2√2, √(3/2) = √6/2, √(1/4) = 1/2, √0 = 0.
+        assert_eq!(s(3, 0, 0, 0).sqrt(), Some(s(0, 0, 1, 0)));
+        assert_eq!(s(6, 0, 0, 0).sqrt(), Some(s(0, 0, 0, 1)));
+        assert_eq!(s(8, 0, 0, 0).sqrt(), Some(s(0, 2, 0, 0)));
+        assert_eq!(
+            Surd::from_rational(q(3, 2)).sqrt(),
+            Some(Surd::new(q(0, 1), q(0, 1), q(0, 1), half.clone()))
+        );
+        assert_eq!(
+            Surd::from_rational(q(1, 4)).sqrt(),
+            Some(Surd::from_rational(half))
+        );
+        assert_eq!(s(0, 0, 0, 0).sqrt(), Some(s(0, 0, 0, 0)));
+        // Not in the field: √5, √(1 + √2) (its norm −1 is no square), √√2; negatives.
+        assert_eq!(s(5, 0, 0, 0).sqrt(), None);
+        assert_eq!(s(1, 1, 0, 0).sqrt(), None);
+        assert_eq!(s(0, 1, 0, 0).sqrt(), None);
+        assert_eq!(s(-1, 0, 0, 0).sqrt(), None);
+        assert_eq!(s(1, -1, 0, 0).sqrt(), None); // 1 − √2 < 0
+        // Every square of a small element has its absolute value as root.
+        for a in -2..=2 {
+            for b in -2..=2 {
+                for c in -1..=1 {
+                    for d in -1..=1 {
+                        let x = s(a, b, c, d);
+                        let root = (&x * &x).sqrt().expect("a square");
+                        let abs = if x.signum() < 0 {
+                            -x.clone()
+                        } else {
+                            x.clone()
+                        };
+                        assert_eq!(root, abs, "{x}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
