@@ -402,9 +402,11 @@ fn progress_is_one_line_per_phase_off_a_terminal_and_quiet_silences_it() {
         .map(str::to_string)
         .collect();
     // One line as each phase starts, and within the optimisation one as each of its stages
-    // starts, with how many variants it has to do.
-    let (stages, lines): (Vec<String>, Vec<String>) =
-        all.into_iter().partition(|l| l.contains(" to do ("));
+    // starts, with how many variants it has to do (the evaluations, which run their variants
+    // together, without).
+    let (stages, lines): (Vec<String>, Vec<String>) = all
+        .into_iter()
+        .partition(|l| l.contains(" into the phase)"));
     assert_eq!(lines.len(), 4, "{lines:?}");
     assert!(lines[0].starts_with("[1/4] Phase 1: unbalanced robot over all tasks (elapsed "));
     assert!(lines[3].starts_with("[4/4] Phase 3: ranking"), "{lines:?}");
@@ -420,7 +422,13 @@ fn progress_is_one_line_per_phase_off_a_terminal_and_quiet_silences_it() {
     );
     let last_two: Vec<&str> = stages[stages.len() - 2..]
         .iter()
-        .map(|l| l[optimisation.len()..].split(',').next().unwrap())
+        .map(|l| {
+            l[optimisation.len()..]
+                .split([',', '('])
+                .next()
+                .unwrap()
+                .trim()
+        })
         .collect();
     assert_eq!(
         last_two,
@@ -430,6 +438,39 @@ fn progress_is_one_line_per_phase_off_a_terminal_and_quiet_silences_it() {
     let (o, _) = run_pendulum(dir.path(), "quiet", &["--quiet"]);
     assert_eq!(stderr(&o), "");
     assert!(stdout(&o).contains("wrote "));
+}
+
+/// The partial balancing `run` adds when no variant is feasible is known only after the four
+/// counted phases have printed `[n/4]`: it is labelled `[+]`, never `[5/5]`. The pendulum
+/// bounded to `m ≤ 2 kg`, `|r| ≤ 0.25 m`, `K ≤ 1 N/m` cannot be balanced (it needs
+/// `m·r = 1 kg·m`), so it has no feasible variant.
+#[test]
+fn the_partial_balancing_phase_is_labelled_outside_the_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut case = case_json("pendulum.json");
+    case["balancing"]["bounds"] =
+        serde_json::json!({ "mass": [0, 2], "radius": [0, 0.25], "stiffness": [0, 1] });
+    let path = write_case(dir.path(), "pendulum.json", &case);
+    let out_dir = dir.path().join("out");
+    let o = counterpoise(&["run", &path, "--out", out_dir.to_str().unwrap()]);
+    assert_success(&o);
+    let phases: Vec<String> = stderr(&o)
+        .lines()
+        .filter(|l| l.starts_with('[') && !l.contains(" into the phase)"))
+        .map(|l| l.split(" (elapsed").next().unwrap().to_string())
+        .collect();
+    assert_eq!(
+        phases,
+        [
+            "[1/4] Phase 1: unbalanced robot over all tasks",
+            "[2/4] Phase 2: balance search",
+            "[3/4] Phase 2: optimisation of the 2 balanced variants",
+            "[4/4] Phase 3: ranking, torque curves, path",
+            "[+] Partial balancing (no feasible variant)",
+        ],
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]

@@ -15,6 +15,9 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+/// The label of a phase outside the count ([`Progress::extra_phase`]).
+pub const EXTRA: &str = "[+]";
+
 /// How progress is shown.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
@@ -52,9 +55,20 @@ impl Progress {
 
     /// Starts the next phase.
     pub fn phase(&mut self, name: &str) -> Phase {
-        let started = *self.started.get_or_insert_with(Instant::now);
         self.next += 1;
         let label = format!("[{}/{}] {name}", self.next, self.phases.max(self.next));
+        self.start(label)
+    }
+
+    /// Starts a phase that only some runs need (the partial balancing when no variant is
+    /// feasible), known only once the counted phases are under way: it is labelled `[+]`
+    /// instead of a count, so that the counts already printed (`[3/4]`) stay true.
+    pub fn extra_phase(&mut self, name: &str) -> Phase {
+        self.start(format!("{EXTRA} {name}"))
+    }
+
+    fn start(&mut self, label: String) -> Phase {
+        let started = *self.started.get_or_insert_with(Instant::now);
         let bar = match self.mode {
             Mode::Quiet => None,
             Mode::Lines => {
@@ -98,16 +112,49 @@ pub fn time_left(elapsed: Duration, done: usize, total: usize) -> Option<Duratio
     (done > 0 && done <= total).then(|| elapsed.mul_f64((total - done) as f64 / done as f64))
 }
 
+/// How far a stage is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Count {
+    /// `done` of `total` items (variants), shown as `312/1169`.
+    Items { done: usize, total: usize },
+    /// `done` of `total` of work whose items all end together (a grid evaluation of many
+    /// variants), shown as a percentage.
+    Share { done: usize, total: usize },
+}
+
+impl Count {
+    fn parts(self) -> (usize, usize) {
+        match self {
+            Count::Items { done, total } | Count::Share { done, total } => (done, total),
+        }
+    }
+
+    /// `312/1169` or `41 %`.
+    pub fn shown(self) -> String {
+        match self {
+            Count::Items { done, total } => format!("{done}/{total}"),
+            Count::Share { done, total } => {
+                format!("{} %", (100 * done.min(total)) / total.max(1))
+            }
+        }
+    }
+}
+
 impl Phase {
-    /// The phase's work reached `done` of `total` items of `stage` (called from any thread).
-    pub fn report(&self, stage: &str, done: usize, total: usize) {
+    /// The phase's work reached `count` in `stage` (called from any thread).
+    pub fn report(&self, stage: &str, count: Count) {
+        let (done, total) = count.parts();
         let mut current = self.stage.lock().expect("progress lock");
         let new_stage = current.as_ref().is_none_or(|(s, _)| s != stage);
         if new_stage {
             *current = Some((stage.to_string(), Instant::now()));
             if self.mode == Mode::Lines {
+                let to_do = match count {
+                    Count::Items { total, .. } => format!(", {total} to do"),
+                    Count::Share { .. } => String::new(),
+                };
                 eprintln!(
-                    "{}: {stage}, {total} to do ({:.1} s into the phase)",
+                    "{}: {stage}{to_do} ({:.1} s into the phase)",
                     self.label,
                     self.started.elapsed().as_secs_f64()
                 );
@@ -117,7 +164,7 @@ impl Phase {
             let left = time_left(since.elapsed(), done, total).map_or(String::new(), |t| {
                 format!(", about {:.0} s left", t.as_secs_f64())
             });
-            bar.set_message(format!("{} — {stage}: {done}/{total}{left}", self.label));
+            bar.set_message(format!("{} — {stage}: {}{left}", self.label, count.shown()));
         }
     }
 
@@ -150,5 +197,28 @@ mod tests {
             time_left(Duration::from_secs(10), 100, 100),
             Some(Duration::ZERO)
         );
+    }
+
+    #[test]
+    fn counts_show_items_or_a_whole_percentage() {
+        assert_eq!(Count::Items { done: 3, total: 50 }.shown(), "3/50");
+        // 417 thousandths: 41.7 %, shown rounded down (never 100 % before the end).
+        assert_eq!(
+            Count::Share {
+                done: 417,
+                total: 1000
+            }
+            .shown(),
+            "41 %"
+        );
+        assert_eq!(
+            Count::Share {
+                done: 999,
+                total: 1000
+            }
+            .shown(),
+            "99 %"
+        );
+        assert_eq!(Count::Share { done: 0, total: 0 }.shown(), "0 %");
     }
 }

@@ -29,6 +29,7 @@ use report::{
     VariantStatus,
 };
 
+use super::progress::Count;
 use super::shard_file::{self, OptimisedRecord, Outcome, ShardFile, StudyKey};
 
 /// Options of the command.
@@ -88,6 +89,12 @@ impl Timer {
         self.time_reporting(name, |_| work())
     }
 
+    /// [`Timer::time`] for a phase outside the count ([`super::progress::Progress::extra_phase`]).
+    fn time_extra<T>(&mut self, name: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
+        let phase = self.progress.extra_phase(name);
+        self.finish_timed(name, phase, |_| work())
+    }
+
     /// [`Timer::time`] for work that reports its own progress to the phase.
     fn time_reporting<T>(
         &mut self,
@@ -95,6 +102,16 @@ impl Timer {
         work: impl FnOnce(&super::progress::Phase) -> Result<T>,
     ) -> Result<T> {
         let phase = self.progress.phase(name);
+        self.finish_timed(name, phase, work)
+    }
+
+    /// Runs `work` as `phase`, ends the phase and records its time.
+    fn finish_timed<T>(
+        &mut self,
+        name: &str,
+        phase: super::progress::Phase,
+        work: impl FnOnce(&super::progress::Phase) -> Result<T>,
+    ) -> Result<T> {
         let started = Instant::now();
         let out = work(&phase);
         let seconds = started.elapsed().as_secs_f64();
@@ -276,6 +293,13 @@ fn optimise(
             ..defaults
         };
         let report = |p: counterpoise_optimise::StageProgress| {
+            let (done, total) = (p.done, p.total);
+            // An evaluation runs its variants together: its share done, as a percentage
+            // (the live line stays within 120 columns without the variant count).
+            let count = match p.unit {
+                counterpoise_optimise::Unit::Variants => Count::Items { done, total },
+                counterpoise_optimise::Unit::Share { .. } => Count::Share { done, total },
+            };
             let stage = if p.stage == "critical-task pass" {
                 format!("{} {}", p.stage, p.pass)
             } else if p.pass > 0 {
@@ -283,7 +307,7 @@ fn optimise(
             } else {
                 p.stage.to_string()
             };
-            phase.report(&stage, p.done, p.total);
+            phase.report(&stage, count);
         };
         let optimised = optimise_all_reporting(&context, &variants, &settings, &report).0;
         if optimised.len() != ids.len() {
@@ -453,10 +477,11 @@ pub fn finish(
     {
         None
     } else {
-        let fallback = timer.time("Partial balancing (no feasible variant)", || {
+        let fallback = timer.time_extra("Partial balancing (no feasible variant)", || {
             super::partial::fallback::fallback(model, study.dmax, &front.found)
         })?;
         results.metadata.notes.push(fallback.note.clone());
+        results.partial = Some(fallback.section.clone());
         Some(fallback)
     };
     results.metadata.timings = timer.timings;

@@ -50,6 +50,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{DynamicsError, TaskFailure};
 use crate::indicators::{IndicatorAccumulator, Indicators, StatsTable, TaskStats, reduce};
 use crate::params::ParameterSet;
+use crate::progress::{GridProgress, Ticker, silent};
 use crate::reactions::JointReactions;
 use crate::runner::{Evaluator, Workspace};
 use crate::tasks::TaskSet;
@@ -192,6 +193,16 @@ pub fn evaluate_grid(
     params: &ParameterSet,
     options: &EvaluateOptions,
 ) -> Result<GridEvaluation, DynamicsError> {
+    evaluate_grid_reporting(model, params, options, &silent)
+}
+
+/// [`evaluate_grid`] that reports the units of work done to `progress`.
+fn evaluate_grid_reporting(
+    model: &Model,
+    params: &ParameterSet,
+    options: &EvaluateOptions,
+    progress: GridProgress,
+) -> Result<GridEvaluation, DynamicsError> {
     let (tasks, ev, cyclic) = grid_setup(model, params, options)?;
     let joints = if options.reactions {
         ev.reactions.joint_count()
@@ -208,10 +219,11 @@ pub fn evaluate_grid(
             options.reactions,
             Combination::Direct,
             crate::fast::GridSink::Table(&mut table),
+            progress,
         ),
         None => {
             let mut failures = Vec::new();
-            for (w, r) in direct_tasks(&ev, &tasks, params, options.reactions)
+            for (w, r) in direct_tasks(&ev, &tasks, params, options.reactions, progress)
                 .into_iter()
                 .enumerate()
             {
@@ -272,9 +284,22 @@ pub fn evaluate_grid_indicators_with(
     options: &EvaluateOptions,
     combination: Combination,
 ) -> Result<GridIndicators, DynamicsError> {
+    evaluate_grid_indicators_reporting(model, params, options, combination, &silent)
+}
+
+/// [`evaluate_grid_indicators_with`] that reports the units of work done (sub-tasks of the
+/// cyclic decomposition, or tasks) to `progress` as they end, for a progress line that moves
+/// during one long batch; the indicators are the same bits.
+pub fn evaluate_grid_indicators_reporting(
+    model: &Model,
+    params: &ParameterSet,
+    options: &EvaluateOptions,
+    combination: Combination,
+    progress: GridProgress,
+) -> Result<GridIndicators, DynamicsError> {
     let (tasks, ev, cyclic) = grid_setup(model, params, options)?;
     let Some(cyc) = cyclic else {
-        let grid = evaluate_grid(model, params, options)?;
+        let grid = evaluate_grid_reporting(model, params, options, progress)?;
         return Ok(GridIndicators {
             indicators: grid.indicators,
             excluded: grid.excluded,
@@ -296,6 +321,7 @@ pub fn evaluate_grid_indicators_with(
         options.reactions,
         combination,
         crate::fast::GridSink::Maxima(&mut maxima),
+        progress,
     );
     let indicators = maxima.finish(&ev.actuator_names(), &ev.joint_names(), |w| tasks.pair(w));
     Ok(GridIndicators {
@@ -312,8 +338,10 @@ fn direct_tasks(
     tasks: &TaskSet,
     params: &ParameterSet,
     with_reactions: bool,
+    progress: GridProgress,
 ) -> Vec<Result<Vec<TaskStats>, TaskFailure>> {
     let grid_q: Vec<_> = tasks.points.par_iter().map(|u| ev.solve_point(u)).collect();
+    let ticker = Ticker::start(progress, tasks.len());
     (0..tasks.len())
         .into_par_iter()
         .map_init(Workspace::default, |ws, w| {
@@ -344,6 +372,7 @@ fn direct_tasks(
                 reason,
             })
         })
+        .inspect(|_| ticker.tick())
         .collect()
 }
 

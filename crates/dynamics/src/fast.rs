@@ -47,6 +47,7 @@ use crate::law::{quintic, quintic_move, sample_time};
 use crate::lu::SmallLu;
 use crate::mechanism::{BodyKin, Scratch};
 use crate::params::ParameterSet;
+use crate::progress::{GridProgress, Ticker};
 use crate::reactions::ReactionWork;
 use crate::regressor::{WrenchRegressor, wrench_regressor};
 use crate::runner::Evaluator;
@@ -338,7 +339,9 @@ pub(crate) enum GridSink<'a> {
 }
 
 /// Runs the grid through the cyclic decomposition into `sink`; returns the failures in task
-/// order and the number of distinct moves evaluated.
+/// order and the number of distinct moves evaluated. `progress` hears of every sub-task as it
+/// ends (counted inside the parallel loops, whatever the sink).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn evaluate_cyclic(
     ev: &Evaluator,
     cyc: Cyclic,
@@ -347,6 +350,7 @@ pub(crate) fn evaluate_cyclic(
     with_reactions: bool,
     combination: Combination,
     sink: GridSink,
+    progress: GridProgress,
 ) -> (Vec<TaskFailure>, usize) {
     let mech = &ev.mech;
     let n = mech.n;
@@ -506,12 +510,17 @@ pub(crate) fn evaluate_cyclic(
         );
         Ok((rows, users[st].iter().map(|u| u.0).zip(slot).collect()))
     };
+    let ticker = Ticker::start(progress, st_pairs.len());
     let mut distinct = 0;
     match sink {
         GridSink::Table(table) => {
             let computed: Vec<SubTaskOutcome> = (0..st_pairs.len())
                 .into_par_iter()
-                .map_init(Work::default, |work, st| one_sub_task(work, st, None))
+                .map_init(Work::default, |work, st| {
+                    let outcome = one_sub_task(work, st, None);
+                    ticker.tick();
+                    outcome
+                })
                 .collect();
             for outcome in computed {
                 match outcome {
@@ -539,7 +548,9 @@ pub(crate) fn evaluate_cyclic(
                     .fold(
                         || (Work::default(), empty.clone(), Vec::new(), 0usize),
                         |(mut work, mut m, mut failed, mut count), st| {
-                            match one_sub_task(&mut work, st, floor) {
+                            let outcome = one_sub_task(&mut work, st, floor);
+                            ticker.tick();
+                            match outcome {
                                 Ok((rows, assignment)) => {
                                     count += rows.len();
                                     for (w, u) in assignment {

@@ -22,6 +22,7 @@ pub mod lu;
 pub mod mechanism;
 pub mod params;
 pub mod paths;
+pub mod progress;
 pub mod reactions;
 pub mod regressor;
 pub mod runner;
@@ -33,10 +34,12 @@ pub use error::{DynamicsError, FailureReason, TaskFailure};
 pub use evaluate::{
     Combination, EvaluateOptions, EvaluationReport, Excluded, GridEvaluation, GridIndicators,
     JointSeries, Series, evaluate, evaluate_grid, evaluate_grid_indicators,
-    evaluate_grid_indicators_with, task_series, task_series_with,
+    evaluate_grid_indicators_reporting, evaluate_grid_indicators_with, task_series,
+    task_series_with,
 };
 pub use indicators::{ActuatorIndicators, Indicators, JointIndicators, TaskStats};
 pub use params::{Counterweight, ParameterSet, Spring, SpringSlot, Variant};
 pub use paths::{PathSeries, path_series};
+pub use progress::GridProgress;
 pub use runner::Evaluator;
 pub use tasks::TaskSet;

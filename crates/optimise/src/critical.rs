@@ -19,7 +19,10 @@ use counterpoise_balance::linear::solve;
 use counterpoise_balance::{Attachment, Status, VariantResult};
 use counterpoise_dynamics::params::{Counterweight, ParameterSet, Spring, Variant};
 use counterpoise_dynamics::runner::Workspace;
-use counterpoise_dynamics::{EvaluateOptions, Evaluator, Indicators, evaluate_grid_indicators};
+use counterpoise_dynamics::{
+    Combination, EvaluateOptions, Evaluator, GridProgress, Indicators,
+    evaluate_grid_indicators_reporting,
+};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -27,7 +30,7 @@ use serde::{Deserialize, Serialize};
 use crate::certify::{BranchOptions, Design, SearchState, Verdict, branch_and_bound};
 use crate::context::Context;
 use crate::problem::{CwPhysical, Objective, VariantProblem};
-use crate::progress::{ProgressSink, StageCounter};
+use crate::progress::{ProgressSink, ShareCounter, StageCounter};
 use crate::refine::{
     FEASIBILITY_TOL, counterweight_directions, merit, project_fixed, project_radius, refine,
 };
@@ -269,14 +272,14 @@ fn critical_task_loop(
         if evaluated.is_empty() {
             continue;
         }
-        StageCounter::start(
+        let share = ShareCounter::start(
             progress,
             "all-task evaluation",
             timings.passes,
             evaluated.len(),
         );
         let dyn_variants = candidate_variants(runs, &evaluated);
-        let indicators = grid_indicators(ctx, &dyn_variants, false);
+        let indicators = grid_indicators(ctx, &dyn_variants, false, &share);
         timings.loop_grid += started.elapsed();
         let indicators = match indicators {
             Ok(i) => i,
@@ -784,14 +787,17 @@ fn grid_indicators(
     ctx: &Context,
     variants: &[Variant],
     reactions: bool,
+    share: &ShareCounter,
 ) -> Result<Vec<Indicators>, String> {
     let to_base: Vec<bool> = variants
         .iter()
         .map(|v| v.springs.iter().any(|s| s.other.is_none()))
         .collect();
     if to_base.iter().all(|&b| b) || to_base.iter().all(|&b| !b) {
-        return batch_indicators(ctx, variants, reactions);
+        let n = variants.len();
+        return batch_indicators(ctx, variants, reactions, &|d, t| share.batch(0, n, d, t));
     }
+    let with_base_count = to_base.iter().filter(|&&b| b).count();
     let part = |base: bool| -> Result<Vec<Indicators>, String> {
         let members: Vec<Variant> = variants
             .iter()
@@ -799,7 +805,12 @@ fn grid_indicators(
             .filter(|(_, b)| **b == base)
             .map(|(v, _)| v.clone())
             .collect();
-        batch_indicators(ctx, &members, reactions)
+        // The batch with springs to the base runs first.
+        let before = if base { 0 } else { with_base_count };
+        let n = members.len();
+        batch_indicators(ctx, &members, reactions, &|d, t| {
+            share.batch(before, n, d, t)
+        })
     };
     let (mut with_base, mut without) = (part(true)?.into_iter(), part(false)?.into_iter());
     Ok(to_base
@@ -816,14 +827,21 @@ fn batch_indicators(
     ctx: &Context,
     variants: &[Variant],
     reactions: bool,
+    progress: GridProgress,
 ) -> Result<Vec<Indicators>, String> {
     let params = ParameterSet::from_variants(&ctx.model, variants).map_err(|e| e.to_string())?;
     let mut evaluate_options = EvaluateOptions::default();
     evaluate_options.reactions = reactions;
     // Only the indicators are needed: the streaming evaluation keeps running maxima per
     // variant instead of a table of every task and variant (tasks × variants × 33 values).
-    let grid = evaluate_grid_indicators(&ctx.model, &params, &evaluate_options)
-        .map_err(|e| e.to_string())?;
+    let grid = evaluate_grid_indicators_reporting(
+        &ctx.model,
+        &params,
+        &evaluate_options,
+        Combination::Direct,
+        progress,
+    )
+    .map_err(|e| e.to_string())?;
     Ok(grid.indicators)
 }
 
@@ -1097,12 +1115,12 @@ fn finish(
                 && matches!(runs[k].state, State::Converged | State::Stopped)
         })
         .collect();
-    StageCounter::start(progress, "final evaluation", 0, finals.len());
+    let share = ShareCounter::start(progress, "final evaluation", 0, finals.len());
     let variants = candidate_variants(&runs, &finals);
     let final_indicators = if variants.is_empty() {
         Ok(Vec::new())
     } else {
-        grid_indicators(ctx, &variants, options.final_reactions)
+        grid_indicators(ctx, &variants, options.final_reactions, &share)
     };
     let mut indicators_of: Vec<Option<Result<Indicators, String>>> = vec![None; runs.len()];
     for (n, &k) in finals.iter().enumerate() {

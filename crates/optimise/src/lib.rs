@@ -48,7 +48,7 @@ pub use critical::{
 pub use error::OptimiseError;
 pub use overrides::{BoundsTable, CounterweightBounds, ElementBounds, SpringBounds};
 pub use problem::Objective;
-pub use progress::{ProgressSink, StageProgress};
+pub use progress::{ProgressSink, StageProgress, Unit};
 pub use result::{
     DisplayRow, FreeParameter, Iteration, OptimisedCounterweight, OptimisedSpring, OptimisedStatus,
     OptimisedVariant, display_rows,

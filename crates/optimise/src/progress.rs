@@ -6,7 +6,7 @@
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Where the optimisation is: `done` of `total` items of the named stage.
+/// Where the optimisation is: `done` of `total` of the named stage, counted in `unit`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StageProgress {
     /// `"critical-task pass 1"`, `"spring choice"`, `"final evaluation"`, …
@@ -15,7 +15,22 @@ pub struct StageProgress {
     pub pass: usize,
     pub done: usize,
     pub total: usize,
+    pub unit: Unit,
 }
+
+/// What a stage's `done` and `total` count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// Variants, each counted as it leaves the stage.
+    Variants,
+    /// The share of a grid evaluation of `variants` variants, in thousandths (`total` is
+    /// [`SHARE_SCALE`]): the evaluation runs its variants together over the task grid, so
+    /// they all end at once and only the share of the grid done can move.
+    Share { variants: usize },
+}
+
+/// The `total` of a [`Unit::Share`] stage.
+pub const SHARE_SCALE: usize = 1000;
 
 /// Receives progress reports (from any thread).
 pub type ProgressSink<'a> = &'a (dyn Fn(StageProgress) + Sync);
@@ -45,6 +60,7 @@ impl<'a> StageCounter<'a> {
             pass,
             done: 0,
             total,
+            unit: Unit::Variants,
         });
         StageCounter {
             sink,
@@ -63,6 +79,61 @@ impl<'a> StageCounter<'a> {
             pass: self.pass,
             done,
             total: self.total,
+            unit: Unit::Variants,
+        });
+    }
+}
+
+/// Reports the share done of a stage that evaluates `variants` variants over the task grid,
+/// possibly as consecutive batches (variants with springs to the base apart from the others).
+pub struct ShareCounter<'a> {
+    sink: ProgressSink<'a>,
+    stage: &'static str,
+    pass: usize,
+    variants: usize,
+}
+
+impl<'a> ShareCounter<'a> {
+    /// Reports the stage's start (0 of [`SHARE_SCALE`]).
+    pub fn start(
+        sink: ProgressSink<'a>,
+        stage: &'static str,
+        pass: usize,
+        variants: usize,
+    ) -> ShareCounter<'a> {
+        let counter = ShareCounter {
+            sink,
+            stage,
+            pass,
+            variants,
+        };
+        counter.send(0);
+        counter
+    }
+
+    /// A batch of `members` variants, which follows batches of `before` variants of the
+    /// stage, has done `done` of its `total` units of work: each batch weighs as its share of
+    /// the stage's variants.
+    pub fn batch(&self, before: usize, members: usize, done: usize, total: usize) {
+        let variants = self.variants.max(1) as f64;
+        let within = if total == 0 {
+            1.0
+        } else {
+            done.min(total) as f64 / total as f64
+        };
+        let share = (before as f64 + members as f64 * within) / variants;
+        self.send(((share * SHARE_SCALE as f64).floor() as usize).min(SHARE_SCALE));
+    }
+
+    fn send(&self, done: usize) {
+        (self.sink)(StageProgress {
+            stage: self.stage,
+            pass: self.pass,
+            done,
+            total: SHARE_SCALE,
+            unit: Unit::Share {
+                variants: self.variants,
+            },
         });
     }
 }
@@ -85,5 +156,21 @@ mod tests {
         let mut seen = seen.into_inner().unwrap();
         seen.sort();
         assert_eq!(seen, vec![(0, 3), (1, 3), (2, 3), (3, 3)]);
+    }
+
+    #[test]
+    fn batches_weigh_as_their_share_of_the_variants() {
+        let seen = Mutex::new(Vec::new());
+        let sink = |p: StageProgress| {
+            assert_eq!(p.unit, Unit::Share { variants: 4 });
+            seen.lock().unwrap().push(p.done);
+        };
+        let counter = ShareCounter::start(&sink, "final evaluation", 0, 4);
+        // One variant in a batch of 10 units, then three in a batch of 4 units.
+        counter.batch(0, 1, 5, 10); // half of 1/4: 125 thousandths
+        counter.batch(0, 1, 10, 10); // 1/4
+        counter.batch(1, 3, 2, 4); // 1/4 + 3/4 · 1/2 = 5/8
+        counter.batch(1, 3, 4, 4); // all
+        assert_eq!(seen.into_inner().unwrap(), vec![0, 125, 250, 625, 1000]);
     }
 }

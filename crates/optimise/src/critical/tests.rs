@@ -202,6 +202,12 @@ fn the_final_checks_decide_the_verdict() {
             &ctx,
             &candidate_variants(std::slice::from_ref(run), &[0]),
             true,
+            &crate::progress::ShareCounter::start(
+                &crate::progress::silent,
+                "final evaluation",
+                0,
+                1,
+            ),
         )
         .unwrap()
         .pop()
