@@ -9,7 +9,9 @@
 //! `cos(th1/2)`).
 //!
 //! `atan2(y, x)` of constants names a constant angle; with rational `x`, `y` and a rational
-//! hypotenuse (`atan2(4, 3)`: cosine 3/5, sine 4/5) the rotation it makes stays exact.
+//! hypotenuse (`atan2(4, 3)`: cosine 3/5, sine 4/5) the rotation it makes stays exact over ℚ,
+//! and with `x`, `y` and the hypotenuse in ℚ(√2, √3) (`atan2(1, 1)` = π/4) exact over that field
+//! (see [`crate::field_surd`]).
 //!
 //! Lowering is generic over the coefficient [`Field`]: the same code builds the numeric
 //! polynomials and, for the balance decision, the exact ones.
