@@ -9,8 +9,9 @@
 //!
 //! `atan2(y, x)` of field numbers is exact exactly when the hypotenuse `√(x² + y²)` lies in the
 //! field (the cosine is `x` over it): `atan2(1, 1)` is π/4 and `atan2(2*sin(pi/3), 1)` is π/3
-//! (found as twelfth turns, so they print and add as such; see `surd_atan2`), `atan2(1, sqrt 2)`
-//! a rotation with cosine √3/3; `atan2(1, 2)` (cosine 2/√5) is refused with the reason.
+//! (found as twelfth turns, so they print and add as such; see `surd_atan2`), and
+//! `atan2(2*sin(pi/4), 1)` = atan2(√2, 1) the rotation with cosine 1/√3 = √3/3 and sine √6/3;
+//! `atan2(1, 2)` (cosine 2/√5) is refused with the reason.
 
 use crate::field::{ExactConstant, Field};
 use crate::scalar::{Rational, Scalar};
