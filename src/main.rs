@@ -78,6 +78,10 @@ enum Command {
         /// Print every set's design as JSON instead of tables.
         #[arg(long)]
         json: bool,
+        /// Sets of counterweights only (default: counterweights and springs; the spring sets
+        /// take most of the time).
+        #[arg(long)]
+        counterweights_only: bool,
         #[command(flatten)]
         jobs: Jobs,
     },
@@ -283,6 +287,7 @@ fn run(cli: Cli) -> ExitCode {
             points,
             top,
             json,
+            counterweights_only,
             ..
         } => commands::partial::run(
             &case,
@@ -292,6 +297,7 @@ fn run(cli: Cli) -> ExitCode {
                 points,
                 top,
                 json,
+                springs: !counterweights_only,
             },
         ),
         Command::Evaluate {

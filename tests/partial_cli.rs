@@ -1,5 +1,6 @@
-//! `counterpoise partial`: the command against hand calculations (the pendulum's closed form),
-//! joint selection by actuator or joint name, the case's bounds and overrides, and its errors.
+//! `counterpoise partial`: the command against hand calculations (the pendulum's closed forms,
+//! with a counterweight and with a spring), joint selection by actuator or joint name, the
+//! case's bounds and overrides, and its errors.
 
 mod common;
 
@@ -27,13 +28,42 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
 /// the best counterweight is `m·r = (−0.5, 0)` (the grid is symmetric, so `Σ cos θ sin θ = 0`
 /// and the `sin θ` component only adds), which halves the torque: RMS `9.81·0.5·√(mean cos²)`.
 /// The lightest such design is 2 kg at 0.25 m.
+///
+/// The spring `K10` (rod to base) exerts `−K·bᵀR(θ)a`'s derivative, at best `−K|a||b| cos θ`
+/// (b a quarter turn ahead of a); with `K ≤ 100 N/m`, `|a| ≤ 0.1 m`, `|b| ≤ 0.5 m` that is
+/// `5 cos θ`, leaving `(9.81 − 5)/9.81 = 49.0 %` of the torque: it ranks before the
+/// counterweight's 50 %, and is certified (in the plane the relaxation is exact).
 #[test]
 fn pendulum_matches_the_closed_form() {
     let dir = tempfile::tempdir().unwrap();
     let mut case = case_json("pendulum.json");
-    case["balancing"]["bounds"] = json!({ "mass": [0, 2], "radius": [0, 0.25] });
+    case["balancing"]["bounds"] = json!({
+        "mass": [0, 2], "radius": [0, 0.25],
+        "stiffness": [0, 100], "anchor_a": [0, 0.1], "anchor_b": [0, 0.5]
+    });
     let path = write_case(dir.path(), "pendulum.json", &case);
-    let doc = run_json(&["partial", &path, "--json"]);
+    let both = run_json(&["partial", &path, "--json"]);
+    assert_eq!(both["springs_searched"], true);
+    assert_eq!(both["sets"], 2);
+    let spring = &both["designs"][0];
+    assert_eq!(spring["labels"], json!(["K10"]));
+    let thetas: Vec<f64> = (0..7).map(|i| -1.5 + 0.5 * i as f64).collect();
+    let mean_cos = (thetas.iter().map(|t| t.cos().powi(2)).sum::<f64>() / 7.0).sqrt();
+    assert!(
+        close(f(&spring["total_rms"]), (G - 5.0) * mean_cos, 1e-6),
+        "{spring}"
+    );
+    assert_eq!(spring["certified"], true, "{spring}");
+    assert!(f(&spring["gap"]) < 1e-3 * G * mean_cos, "{spring}");
+    let k = &spring["springs"][0];
+    assert_eq!(k["body_name"], "rod");
+    assert_eq!(k["other_name"], "base");
+    assert!(close(f(&k["stiffness"]), 100.0, 1e-5), "{k}");
+    assert!(close(f(&k["torque_rms"]), 5.0 * mean_cos, 1e-5), "{k}");
+    assert_eq!(both["designs"][1]["labels"], json!(["m1"]));
+    let doc = run_json(&["partial", &path, "--json", "--counterweights-only"]);
+    assert_eq!(doc["springs_searched"], false);
+    assert_eq!(doc["sets"], 1);
     let thetas: Vec<f64> = (0..7).map(|i| -1.5 + 0.5 * i as f64).collect();
     let mean_cos2 = thetas.iter().map(|t| t.cos().powi(2)).sum::<f64>() / 7.0;
     let unbalanced = G * mean_cos2.sqrt();
@@ -97,12 +127,37 @@ fn joints_are_chosen_by_actuator_or_joint_name() {
 fn bounds_and_overrides_are_respected() {
     let dir = tempfile::tempdir().unwrap();
     let mut case = case_json("two_link.json");
-    case["balancing"]["bounds"] = json!({ "mass": [0, 1.5], "radius": [0, 0.4] });
+    case["balancing"]["bounds"] = json!({
+        "mass": [0, 1.5], "radius": [0, 0.4],
+        "stiffness": [5, 50], "anchor_a": [0.1, 0.3], "anchor_b": [0, 0.2]
+    });
     case["balancing"]["overrides"] = json!([{ "element": "m2", "radius": [0, 0.2] }]);
     let path = write_case(dir.path(), "two_link.json", &case);
     let doc = run_json(&["partial", &path, "--json"]);
-    assert_eq!(doc["sets"], 3);
+    // m1, m2, K10, K20, K21: 5 sets of one, 10 of two
+    assert_eq!(doc["sets"], 15);
+    let norm = |v: &Value| {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| f(x).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
     for d in doc["designs"].as_array().unwrap() {
+        for s in d["springs"].as_array().unwrap() {
+            let k = f(&s["stiffness"]);
+            assert!(
+                (5.0 * (1.0 - 1e-7)..=50.0 * (1.0 + 1e-7)).contains(&k),
+                "{s}"
+            );
+            let a = norm(&s["anchor_a"]);
+            assert!(
+                (0.1 * (1.0 - 1e-6)..=0.3 * (1.0 + 1e-6)).contains(&a),
+                "{s}"
+            );
+            assert!(norm(&s["anchor_b"]) <= 0.2 * (1.0 + 1e-6), "{s}");
+        }
         for cw in d["counterweights"].as_array().unwrap() {
             let m = f(&cw["mass"]);
             let r = cw["offset"]
@@ -134,12 +189,13 @@ fn the_table_shows_the_exact_verdict_beside_the_residual() {
         "1",
         "--top",
         "1",
+        "--counterweights-only",
     ]);
     assert_success(&out);
     let text = stdout(&out);
     let line = text
         .lines()
-        .find(|l| l.trim_start().starts_with("1  m4 "))
+        .find(|l| l.split_whitespace().nth(1) == Some("m4"))
         .unwrap_or_else(|| panic!("{text}"));
     assert!(line.contains("balanced"), "{line}");
     assert!(text.contains("343 points, 343 used"), "{text}");
@@ -165,13 +221,16 @@ fn bad_options_are_errors_naming_the_option() {
         .unwrap()
         .remove("counterweights");
     let path = write_case(dir.path(), "springs.json", &case);
-    let out = counterpoise(&["partial", &path]);
+    let out = counterpoise(&["partial", &path, "--counterweights-only"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
-        stderr(&out).contains("allows no counterweight"),
+        stderr(&out).contains("allows no counterweight (--counterweights-only)"),
         "{}",
         stderr(&out)
     );
+    // its springs alone are searched
+    let out = counterpoise(&["partial", &path, "--budget", "1"]);
+    assert_success(&out);
 }
 
 /// `variants` points to `--minimal` and `partial` when nothing balances (the 6-axis arm needs
@@ -242,13 +301,15 @@ fn run_adds_the_partial_balancing_when_no_variant_is_feasible() {
         "{best}"
     );
     assert_eq!(doc["smallest_dmax"]["smallest_balanced"], 1);
-    // One counterweight: one set, one CSV row under the header.
+    // `run`'s partial balancing is of counterweights only: one set, one CSV row under the
+    // header.
     let csv = std::fs::read_to_string(out_dir.join("partial.csv")).unwrap();
     assert_eq!(csv.lines().count(), 2, "{csv}");
     assert!(
         csv.lines().nth(1).unwrap().starts_with("1,\"m1\",1,"),
         "{csv}"
     );
+    assert_eq!(doc["springs_searched"], false);
     // The note reaches results.json and the reports.
     let results: Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("results.json")).unwrap())

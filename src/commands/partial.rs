@@ -1,7 +1,8 @@
 //! `counterpoise partial CASE`: the best partial balancing within a budget of elements — the
-//! sets of counterweights and their parameters, within the case's bounds, that leave the least
-//! RMS gravity torque over the workspace on the joints that matter, ranked, each beside the
-//! exact balance search's verdict on the same set.
+//! sets of counterweights and springs and their parameters, within the case's bounds, that
+//! leave the least RMS gravity torque over the workspace on the joints that matter, ranked,
+//! each beside the exact balance search's verdict on the same set and the gap to its lower
+//! bound.
 
 pub mod fallback;
 
@@ -12,12 +13,13 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use counterpoise_balance::linear::LiftedBasis;
 use counterpoise_balance::partial::{
-    CounterweightLimits, PartialDesign, PartialOptions, PartialReport, TorqueBasis, Workspace,
-    counterweight_entries, partial_search, set_count,
+    CERTIFY, CounterweightLimits, ElementLimits, PartialDesign, PartialOptions, PartialReport,
+    SpringLimits, TorqueBasis, Workspace, candidate_entries, partial_search, set_count,
 };
 use counterpoise_balance::search::decide;
 use counterpoise_balance::{
-    Catalogue, Status, VerificationSet, catalogue_options, mechanism_energy, realization_hints,
+    Attachment, Catalogue, Status, VerificationSet, catalogue_options, mechanism_energy,
+    realization_hints,
 };
 use counterpoise_dynamics::Evaluator;
 use counterpoise_model::limits::{Limit, format_count};
@@ -42,6 +44,8 @@ pub struct Options {
     /// Best designs shown per size.
     pub top: usize,
     pub json: bool,
+    /// Sets drawn from the springs too (`--counterweights-only` turns it off).
+    pub springs: bool,
 }
 
 /// The actuators named by `names` (an actuator's name or its joint's), in actuator order.
@@ -139,18 +143,28 @@ fn workspace_points(model: &Model, points: Option<usize>) -> Result<(Vec<Vec<f64
     Ok((grid, n))
 }
 
-/// Every counterweight's bounds (the case's `bounds` with its overrides); springs `None`.
-fn limits(model: &Model, catalogue: &Catalogue) -> Result<Vec<Option<CounterweightLimits>>> {
+/// Every element's bounds (the case's `bounds` with its overrides).
+fn limits(model: &Model, catalogue: &Catalogue) -> Result<Vec<Option<ElementLimits>>> {
     let table = BoundsTable::new(model, catalogue)?;
     Ok(table
         .entries
         .iter()
-        .map(|b| match b {
-            ElementBounds::Counterweight(c) => Some(CounterweightLimits {
-                mass: c.mass,
-                radius: c.radius,
-            }),
-            ElementBounds::Spring(_) => None,
+        .map(|b| {
+            Some(match b {
+                ElementBounds::Counterweight(c) => {
+                    ElementLimits::Counterweight(CounterweightLimits {
+                        mass: c.mass,
+                        radius: c.radius,
+                    })
+                }
+                ElementBounds::Spring(s) => ElementLimits::Spring(SpringLimits {
+                    stiffness: s.stiffness,
+                    anchor_a: s.anchor_a,
+                    anchor_b: s.anchor_b,
+                    box_a: s.box_a,
+                    box_b: s.box_b,
+                }),
+            })
         })
         .collect())
 }
@@ -169,18 +183,29 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     let joints = select_joints(&model, options.joints.as_deref())?;
     let energy = mechanism_energy(&model);
     let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
-    if counterweight_entries(&catalogue).is_empty() {
+    if candidate_entries(&catalogue, options.springs).is_empty() {
         bail!(
-            "{}: `balancing` allows no counterweight (partial balancing covers counterweights \
-             only)",
-            path.display()
+            "{}: `balancing` allows no counterweight{}",
+            path.display(),
+            if options.springs {
+                " and no spring"
+            } else {
+                " (--counterweights-only)"
+            }
         );
     }
-    if let Err(e) = set_guard(&catalogue, budget) {
+    if let Err(e) = set_guard_for(&catalogue, budget, options.springs) {
         super::print_errors(path, &super::located(path, vec![e]));
         return Ok(ExitCode::FAILURE);
     }
-    let computed = compute(&model, budget, joints, options.points, options.top)?;
+    let computed = compute_with(
+        &model,
+        budget,
+        joints,
+        options.points,
+        options.top,
+        options.springs,
+    )?;
     if options.json {
         println!(
             "{}",
@@ -192,17 +217,32 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The variant limit applied to the number of sets the search solves.
+/// The variant limit applied to the number of sets [`compute`] solves (counterweights).
 fn set_guard(catalogue: &Catalogue, budget: usize) -> Result<(), ModelError> {
-    let sets = set_count(catalogue, budget);
+    set_guard_for(catalogue, budget, false)
+}
+
+/// [`set_guard`] for the sets of counterweights only when `springs` is false.
+fn set_guard_for(catalogue: &Catalogue, budget: usize, springs: bool) -> Result<(), ModelError> {
+    let sets = set_count(catalogue, budget, springs);
     let limit = counterpoise::preflight::limits().get(Limit::Variants);
     if sets > u128::from(limit) {
         return Err(ModelError::Invalid {
             path: "--budget".into(),
             reason: format!(
-                "{} sets of at most {budget} counterweights; the limit is {}; lower --budget, or {}",
+                "{} sets of at most {budget} {}; the limit is {}; lower --budget{}, or {}",
                 format_count(sets as f64),
+                if springs {
+                    "counterweights and springs"
+                } else {
+                    "counterweights"
+                },
                 format_count(limit as f64),
+                if springs {
+                    ", pass --counterweights-only"
+                } else {
+                    ""
+                },
                 Limit::Variants.hint()
             ),
         });
@@ -214,6 +254,8 @@ fn set_guard(catalogue: &Catalogue, budget: usize) -> Result<(), ModelError> {
 /// the designs shown and the exact search's verdict on each.
 pub struct Computed {
     pub report: PartialReport,
+    /// Whether the sets were drawn from the springs too.
+    pub springs: bool,
     sample: Sample,
     /// Indices into `report.designs` of the designs shown (see [`shown`]).
     pub shown: Vec<usize>,
@@ -224,7 +266,9 @@ pub struct Computed {
 
 /// Solves every set of at most `budget` counterweights of the case for the least RMS gravity
 /// torque on `joints` (actuator indices) over the workspace sample (`points` values per varying
-/// actuator), and decides the `top` best sets of each size exactly.
+/// actuator), and decides the `top` best sets of each size exactly. Counterweights only: this
+/// is `run`'s fallback ([`fallback`]), whose files and tests predate the spring sets; the
+/// command itself calls [`compute_with`].
 pub fn compute(
     model: &Model,
     budget: usize,
@@ -232,10 +276,22 @@ pub fn compute(
     points: Option<usize>,
     top: usize,
 ) -> Result<Computed> {
+    compute_with(model, budget, joints, points, top, false)
+}
+
+/// [`compute`], with the sets drawn from the springs too when `springs` is true.
+pub fn compute_with(
+    model: &Model,
+    budget: usize,
+    joints: Vec<usize>,
+    points: Option<usize>,
+    top: usize,
+    springs: bool,
+) -> Result<Computed> {
     let started = Instant::now();
     let energy = mechanism_energy(model);
     let catalogue = Catalogue::build(&energy, &catalogue_options(model));
-    let candidates = counterweight_entries(&catalogue);
+    let candidates = candidate_entries(&catalogue, springs);
     let bounds = limits(model, &catalogue)?;
     let (targets, per_axis) = workspace_points(model, points)?;
     let evaluator = Evaluator::new(model)?;
@@ -259,7 +315,10 @@ pub fn compute(
         &catalogue,
         &basis,
         &bounds,
-        &PartialOptions::new(budget, joints),
+        &PartialOptions {
+            springs,
+            ..PartialOptions::new(budget, joints)
+        },
     )?;
     // The exact verdict of the sets shown: does the set balance at all, whatever the bounds?
     let shown = shown(&report, top);
@@ -282,6 +341,7 @@ pub fn compute(
         .collect();
     Ok(Computed {
         report,
+        springs,
         sample: Sample {
             requested: targets.len(),
             per_axis,
@@ -333,7 +393,41 @@ fn millimetres(metres: f64) -> f64 {
     if mm == 0.0 { 0.0 } else { mm }
 }
 
+/// The name of a spring's second body, or `base`.
+fn attachment_name(model: &Model, other: Attachment) -> &str {
+    match other {
+        Attachment::Base => "base",
+        Attachment::Body(s) => &model.bodies[s].name,
+    }
+}
+
+/// `(x, y, z)` in mm, rounded to 0.1 mm.
+fn point_mm(p: &[f64; 3]) -> String {
+    format!(
+        "({:.1}, {:.1}, {:.1}) mm",
+        millimetres(p[0]),
+        millimetres(p[1]),
+        millimetres(p[2])
+    )
+}
+
 fn design_line(model: &Model, d: &PartialDesign) -> String {
+    let springs = d.springs.iter().map(|s| {
+        if d.unused.contains(&s.label) {
+            format!("{}: unused (0 N/m)", s.label)
+        } else {
+            format!(
+                "{}: K = {:.1} N/m, a = {} on {}, b = {} on {}, its torque {:.3} RMS",
+                s.label,
+                s.stiffness,
+                point_mm(&s.anchor_a),
+                model.bodies[s.body].name,
+                point_mm(&s.anchor_b),
+                attachment_name(model, s.other),
+                s.torque_rms
+            )
+        }
+    });
     d.counterweights
         .iter()
         .map(|c| {
@@ -353,8 +447,31 @@ fn design_line(model: &Model, d: &PartialDesign) -> String {
                 )
             }
         })
+        .chain(springs)
         .collect::<Vec<_>>()
         .join("; ")
+}
+
+/// The lower bound and whether the design meets it, in one line.
+fn bound_line(d: &PartialDesign, unbalanced: f64) -> String {
+    if d.certified {
+        format!(
+            "certified optimal: lower bound {:.3} (gap {:.3}, within {} % of the unbalanced \
+             total)",
+            d.lower_bound,
+            d.gap,
+            CERTIFY * 100.0
+        )
+    } else if d.lower_bound.is_nan() {
+        "no lower bound (the relaxation failed)".to_string()
+    } else {
+        format!(
+            "not certified: lower bound {:.3}, gap {:.3} ({:.2} % of the unbalanced total)",
+            d.lower_bound,
+            d.gap,
+            100.0 * d.gap / unbalanced.max(f64::MIN_POSITIVE)
+        )
+    }
 }
 
 fn model_label(d: &PartialDesign, entry: usize) -> String {
@@ -367,6 +484,7 @@ fn model_label(d: &PartialDesign, entry: usize) -> String {
 fn tables(model: &Model, computed: &Computed) -> String {
     let Computed {
         report,
+        springs,
         sample,
         shown,
         verdicts,
@@ -375,8 +493,16 @@ fn tables(model: &Model, computed: &Computed) -> String {
     let names: Vec<&str> = model.actuators.iter().map(|a| a.name.as_str()).collect();
     let selected: Vec<&str> = report.joints.iter().map(|&j| names[j]).collect();
     let mut out = format!(
-        "{}: partial balancing with at most {} counterweight(s): {} sets in {:.2} s\n",
-        model.name, report.budget, report.sets, seconds
+        "{}: partial balancing with at most {} {}: {} sets in {:.2} s\n",
+        model.name,
+        report.budget,
+        if *springs {
+            "counterweight(s) and spring(s)"
+        } else {
+            "counterweight(s) (--counterweights-only)"
+        },
+        report.sets,
+        seconds
     );
     out.push_str(&format!(
         "workspace: {} values per varying actuator over the task grid's range → {} points, {} \
@@ -431,15 +557,21 @@ fn tables(model: &Model, computed: &Computed) -> String {
             out.push_str(&format!("      solver status: {}\n", d.status));
         }
         if let Some(note) = &d.note {
-            out.push_str(&format!("      {note}; lower bound {:.3}\n", d.lower_bound));
+            out.push_str(&format!("      {note}\n"));
         }
+        out.push_str(&format!(
+            "      {}\n",
+            bound_line(d, report.unbalanced_total)
+        ));
     }
     out.push_str(
         "\ntotal: RMS over the selected joints; Δ: change against the unbalanced mechanism \
          (negative = less torque); exact: the balance search's verdict on the set, whatever the \
          bounds (balanced = some parameters balance it perfectly; infeasible = no parameters do, \
          on every joint); a set whose best design leaves a counterweight at 0 kg is not shown (the \
-         smaller set is).\n",
+         smaller set is). A design with springs comes from alternating convex programs (one \
+         anchor of every spring fixed) from several starts; its lower bound is a convex \
+         relaxation's, so it is certified optimal only when it meets that bound.\n",
     );
     out
 }
@@ -448,12 +580,26 @@ fn tables(model: &Model, computed: &Computed) -> String {
 pub fn to_json(model: &Model, computed: &Computed) -> serde_json::Value {
     let Computed {
         report,
+        springs,
         sample,
         shown,
         verdicts,
         seconds,
     } = computed;
     let names: Vec<&str> = model.actuators.iter().map(|a| a.name.as_str()).collect();
+    // Each spring with the names of the bodies its anchors are on.
+    let mut designs = serde_json::to_value(&report.designs).unwrap_or_default();
+    if let Some(list) = designs.as_array_mut() {
+        for (d, design) in list.iter_mut().zip(&report.designs) {
+            let Some(springs) = d.get_mut("springs").and_then(|s| s.as_array_mut()) else {
+                continue;
+            };
+            for (s, spring) in springs.iter_mut().zip(&design.springs) {
+                s["body_name"] = json!(model.bodies[spring.body].name);
+                s["other_name"] = json!(attachment_name(model, spring.other));
+            }
+        }
+    }
     let exact: Vec<serde_json::Value> = shown
         .iter()
         .zip(verdicts)
@@ -476,8 +622,10 @@ pub fn to_json(model: &Model, computed: &Computed) -> serde_json::Value {
         "unbalanced_rms": report.unbalanced_rms,
         "unbalanced_total": report.unbalanced_total,
         "sets": report.sets,
+        "springs_searched": springs,
+        "certify_fraction": CERTIFY,
         "exact": exact,
-        "designs": report.designs,
+        "designs": designs,
     })
 }
 

@@ -1,7 +1,8 @@
-//! Partial balancing with counterweights (`counterpoise_balance::partial`) against values found
-//! without it: closed forms worked out by hand on the pendulum, the gravity torques of every
-//! design recomputed from the model's kinematics (Jacobians, not the energy polynomials the
-//! search differentiates), and dense normal equations over those independent torques.
+//! Partial balancing with counterweights and springs (`counterpoise_balance::partial`) against
+//! values found without it: closed forms worked out by hand on the pendulum, the gravity
+//! torques of every design recomputed from the model's kinematics (Jacobians and spring forces,
+//! not the energy polynomials the search differentiates), and dense normal equations over
+//! those independent torques.
 
 mod common;
 
@@ -9,10 +10,10 @@ use std::sync::OnceLock;
 
 use common::model_of;
 use counterpoise_balance::partial::{
-    CounterweightLimits, PartialDesign, PartialOptions, PartialReport, TorqueBasis, Workspace,
-    counterweight_entries, partial_search,
+    CounterweightLimits, ElementLimits, PartialDesign, PartialOptions, PartialReport, SpringLimits,
+    TorqueBasis, Workspace, candidate_entries, counterweight_entries, partial_search,
 };
-use counterpoise_balance::{Catalogue, catalogue_options, mechanism_energy};
+use counterpoise_balance::{Attachment, Catalogue, catalogue_options, mechanism_energy};
 use counterpoise_model::{Kinematics, Model};
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -62,12 +63,17 @@ struct Setup {
 
 impl Setup {
     fn new(model: Model, qs: Vec<Vec<f64>>) -> Setup {
+        Setup::with(model, qs, false)
+    }
+
+    /// The torque basis of the counterweights, and of the springs with `springs`.
+    fn with(model: Model, qs: Vec<Vec<f64>>, springs: bool) -> Setup {
         let energy = mechanism_energy(&model);
         let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
         let workspace = Workspace::new(&model, &qs);
         assert_eq!(workspace.len(), qs.len(), "every point regular");
-        let cws = counterweight_entries(&catalogue);
-        let basis = TorqueBasis::build(&energy, &catalogue, &workspace, &cws);
+        let wanted = candidate_entries(&catalogue, springs);
+        let basis = TorqueBasis::build(&energy, &catalogue, &workspace, &wanted);
         Setup {
             model,
             qs,
@@ -90,10 +96,54 @@ impl Setup {
     fn search_with(&self, limits: CounterweightLimits, options: PartialOptions) -> PartialReport {
         let cws = counterweight_entries(&self.catalogue);
         let bounds: Vec<_> = (0..self.catalogue.len())
-            .map(|e| cws.contains(&e).then_some(limits))
+            .map(|e| {
+                cws.contains(&e)
+                    .then_some(ElementLimits::Counterweight(limits))
+            })
             .collect();
         partial_search(&self.catalogue, &self.basis, &bounds, &options).unwrap()
     }
+
+    /// The search over the entries labelled in `entries` with their bounds (the others left
+    /// out).
+    fn search_entries(
+        &self,
+        entries: &[(&str, ElementLimits)],
+        budget: usize,
+        joints: Vec<usize>,
+    ) -> PartialReport {
+        let bounds: Vec<Option<ElementLimits>> = self
+            .catalogue
+            .entries
+            .iter()
+            .map(|e| {
+                entries
+                    .iter()
+                    .find(|(label, _)| *label == e.label)
+                    .map(|(_, l)| *l)
+            })
+            .collect();
+        assert_eq!(
+            bounds.iter().flatten().count(),
+            entries.len(),
+            "every label in the catalogue"
+        );
+        let options = PartialOptions::new(budget, joints);
+        partial_search(&self.catalogue, &self.basis, &bounds, &options).unwrap()
+    }
+}
+
+/// No box on any anchor coordinate.
+const FREE: [[f64; 2]; 3] = [[f64::NEG_INFINITY, f64::INFINITY]; 3];
+
+fn spring_limits(stiffness: [f64; 2], anchor_a: [f64; 2], anchor_b: [f64; 2]) -> ElementLimits {
+    ElementLimits::Spring(SpringLimits {
+        stiffness,
+        anchor_a,
+        anchor_b,
+        box_a: FREE,
+        box_b: FREE,
+    })
 }
 
 /// The pendulum of `cases/pendulum.json` at 7 angles from −1.5 to 1.5 rad (a grid symmetric
@@ -116,22 +166,56 @@ fn pendulum_mean_cos2() -> f64 {
 /// count in the balance, plus point masses `(body, m, r)`, each needing the world wrench
 /// `F = −m g`, `N_o = (R c) × F`; `Q_q = Σ J_vᵀ F + J_ωᵀ N_o`, `Q_u = G⁻ᵀ Q_q`.
 fn static_forces(model: &Model, q: &[f64], extra: &[(usize, f64, Vector3<f64>)]) -> DVector<f64> {
+    static_forces_with(model, q, extra, &[])
+}
+
+/// A zero-free-length spring for [`static_forces_with`]: `(body, a, other, b, K)`.
+type SpringForce = (usize, Vector3<f64>, Attachment, Vector3<f64>, f64);
+
+/// [`static_forces`] with zero-free-length springs `(body, a, other, b, K)` too: the spring
+/// pulls its anchor on `body` (world `p_A = p_i + R_i a`) with `−K(p_A − p_B)`, so holding it
+/// needs `F = K(p_A − p_B)` applied at `p_A` (the moment `(R_i a) × F` about the body origin),
+/// and `−F` at `p_B` on the other body (nothing on the base).
+fn static_forces_with(
+    model: &Model,
+    q: &[f64],
+    extra: &[(usize, f64, Vector3<f64>)],
+    springs: &[SpringForce],
+) -> DVector<f64> {
     let kin = Kinematics::new(model);
     let qv = DVector::from_column_slice(q);
     let g = model.gravity;
-    let mut masses: Vec<(usize, f64, Vector3<f64>)> = Vec::new();
+    // (body, point in the body frame, world force needed there)
+    let mut forces: Vec<(usize, Vector3<f64>, Vector3<f64>)> = Vec::new();
     for (i, b) in model.bodies.iter().enumerate() {
-        masses.push((i, b.mass, b.com));
+        forces.push((i, b.com, -g * b.mass));
     }
     for p in model.payloads.iter().filter(|p| p.in_balance) {
-        masses.push((p.body, p.mass, p.com));
+        forces.push((p.body, p.com, -g * p.mass));
     }
-    masses.extend_from_slice(extra);
+    for &(body, m, c) in extra {
+        forces.push((body, c, -g * m));
+    }
+    for &(body, a, other, b, k) in springs {
+        let pose = kin.body_pose(body, &qv);
+        let p_a = pose.position + pose.rotation * a;
+        let p_b = match other {
+            Attachment::Base => b,
+            Attachment::Body(s) => {
+                let other = kin.body_pose(s, &qv);
+                other.position + other.rotation * b
+            }
+        };
+        let force = (p_a - p_b) * k;
+        forces.push((body, a, force));
+        if let Attachment::Body(s) = other {
+            forces.push((s, b, -force));
+        }
+    }
     let mut generalized = DVector::zeros(q.len());
-    for (body, m, c) in masses {
+    for (body, c, force) in forces {
         let pose = kin.body_pose(body, &qv);
         let jac = kin.body_jacobian(body, &qv);
-        let force = -g * m;
         let moment = (pose.rotation * c).cross(&force);
         generalized += jac.linear.transpose() * force + jac.angular.transpose() * moment;
     }
@@ -139,16 +223,30 @@ fn static_forces(model: &Model, q: &[f64], extra: &[(usize, f64, Vector3<f64>)])
     jacobian.transpose().lu().solve(&generalized).unwrap()
 }
 
-/// Per actuator, the RMS over `qs` of the static forces with the design's counterweights.
+/// Per actuator, the RMS over `qs` of the static forces with the design's counterweights and
+/// springs.
 fn recomputed_rms(model: &Model, qs: &[Vec<f64>], design: &PartialDesign) -> Vec<f64> {
     let extra: Vec<_> = design
         .counterweights
         .iter()
         .map(|c| (c.body, c.mass, Vector3::from(c.offset)))
         .collect();
+    let springs: Vec<_> = design
+        .springs
+        .iter()
+        .map(|s| {
+            (
+                s.body,
+                Vector3::from(s.anchor_a),
+                s.other,
+                Vector3::from(s.anchor_b),
+                s.stiffness,
+            )
+        })
+        .collect();
     let mut sum = vec![0.0; model.actuators.len()];
     for q in qs {
-        let f = static_forces(model, q, &extra);
+        let f = static_forces_with(model, q, &extra, &springs);
         for (s, v) in sum.iter_mut().zip(f.iter()) {
             *s += v * v;
         }
@@ -497,4 +595,204 @@ fn a_zero_mass_bound_leaves_the_mechanism_as_it_is() {
     assert_eq!(best.counterweights[0].mass, 0.0);
     assert_eq!(best.counterweights[0].offset, [0.0; 3]);
     assert!(close(best.total_rms, report.unbalanced_total, 1e-12));
+}
+
+/// The pendulum of [`pendulum`] with the torque basis of its spring `K10` too.
+fn pendulum_with_springs() -> &'static Setup {
+    static SETUP: OnceLock<Setup> = OnceLock::new();
+    SETUP.get_or_init(|| {
+        let qs = spaced(-1.5, 1.5, 7).into_iter().map(|t| vec![t]).collect();
+        Setup::with(model_of(&case("pendulum.json")), qs, true)
+    })
+}
+
+/// `a × b` (z) and `a · b` in the plane.
+fn cross_dot(a: &[f64; 3], b: &[f64; 3]) -> (f64, f64) {
+    (a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1])
+}
+
+fn norm(v: &[f64; 3]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// The pendulum (2 kg at 0.5 m: `τ = 9.81 cos θ`) with the spring `K10`, anchor a on the rod and
+/// anchor b on the base: `V = ½K|R(θ)a − b|² = const − K·bᵀR(θ)a`, and `bᵀR(θ)a =
+/// |a||b| sin(θ + φ)` with `φ` the angle from b's direction to a's plus 90°; the torque is
+/// `−K|a||b|(cos φ cos θ − sin φ sin θ)`. On the symmetric grid the `sin θ` part only adds, so
+/// the best spring has `φ = 0` (b a quarter turn ahead of a: straight above the pivot for a
+/// along the rod) and the largest `K|a||b|` up to `m g l = 9.81`. With `K ≤ 100 N/m`,
+/// `|a| ≤ 0.1 m`, `|b| ≤ 0.5 m` that is 5 N·m: the residual RMS is `(9.81 − 5)·√(mean cos²)`,
+/// 49.0 % of the unbalanced torque, and the spring's own torque `5·√(mean cos²)`. In the plane
+/// the relaxation (the nuclear norm of `W`) is exact, so the design is certified.
+#[test]
+fn pendulum_spring_below_balance_matches_the_closed_form() {
+    let setup = pendulum_with_springs();
+    let mean_cos = pendulum_mean_cos2().sqrt();
+    let report = setup.search_entries(
+        &[("K10", spring_limits([0.0, 100.0], [0.0, 0.1], [0.0, 0.5]))],
+        1,
+        vec![0],
+    );
+    let best = &report.designs[0];
+    assert_eq!(best.labels, ["K10"]);
+    let expected = (G - 5.0) * mean_cos;
+    assert!(
+        close(best.total_rms, expected, 1e-6),
+        "{} vs {expected}",
+        best.total_rms
+    );
+    assert!(close(
+        best.total_rms / report.unbalanced_total,
+        (G - 5.0) / G,
+        1e-6
+    ));
+    let s = &best.springs[0];
+    assert_eq!(s.other, Attachment::Base);
+    // every bound active: only K = 100 N/m, |a| = 0.1 m, |b| = 0.5 m give 5 N·m
+    assert!(close(s.stiffness, 100.0, 1e-5), "{s:?}");
+    assert!(close(norm(&s.anchor_a), 0.1, 1e-5), "{s:?}");
+    assert!(close(norm(&s.anchor_b), 0.5, 1e-5), "{s:?}");
+    let (cross, dot) = cross_dot(&s.anchor_a, &s.anchor_b);
+    assert!(close(cross, 0.05, 1e-5) && dot.abs() < 1e-6, "{s:?}");
+    assert!(close(s.torque_rms, 5.0 * mean_cos, 1e-5), "{s:?}");
+    assert!(best.certified, "{best:?}");
+    assert!(best.lower_bound <= best.total_rms * (1.0 + 1e-9));
+    assert!(close(best.lower_bound, expected, 1e-5), "{best:?}");
+    // the torque recomputed from the kinematics and the spring's force
+    let rms = recomputed_rms(&setup.model, &setup.qs, best);
+    assert!(
+        close(rms[0], best.rms[0], 1e-9),
+        "{rms:?} vs {:?}",
+        best.rms
+    );
+    assert!(close(rms[0], expected, 1e-6), "{rms:?}");
+}
+
+/// With `|a| ≤ 0.2 m` the spring can give 10 N·m ≥ 9.81: the pendulum balances, and the
+/// lightest (least stiff) balancing spring has `K·0.2·0.5 = 9.81`, `K = 98.1 N/m`.
+#[test]
+fn pendulum_spring_balances_when_the_bounds_allow_it() {
+    let setup = pendulum_with_springs();
+    let report = setup.search_entries(
+        &[("K10", spring_limits([0.0, 100.0], [0.0, 0.2], [0.0, 0.5]))],
+        1,
+        vec![0],
+    );
+    let best = &report.designs[0];
+    assert!(best.total_rms < 1e-6 * report.unbalanced_total, "{best:?}");
+    assert!(best.certified);
+    let s = &best.springs[0];
+    let (cross, _) = cross_dot(&s.anchor_a, &s.anchor_b);
+    assert!(close(s.stiffness * cross, G, 1e-6), "{s:?}");
+    assert!(close(s.stiffness, 98.1, 1e-4), "{s:?}");
+    let rms = recomputed_rms(&setup.model, &setup.qs, best);
+    assert!(rms[0] < 1e-6 * report.unbalanced_total, "{rms:?}");
+}
+
+/// The two-link arm with its counterweights and springs, two elements: on every set the
+/// relaxation's bound is at most the design's residual, every design is within its bounds,
+/// its torques recomputed from the kinematics and spring forces agree, and the ranking is the
+/// same bits on one thread.
+#[test]
+fn two_link_springs_bound_below_and_recomputed() {
+    let model = model_of(&case("two_link.json"));
+    let qs = grid(&[spaced(-1.0, 1.0, 5), spaced(-1.5, 1.5, 5)]);
+    let cw = ElementLimits::Counterweight(CounterweightLimits {
+        mass: [0.0, 2.0],
+        radius: [0.0, 0.3],
+    });
+    let spring = spring_limits([10.0, 200.0], [0.05, 0.3], [0.0, 0.2]);
+    let search = |setup: &Setup| {
+        let entries: Vec<(&str, ElementLimits)> = setup
+            .catalogue
+            .entries
+            .iter()
+            .map(|e| {
+                let l = if e.label.starts_with('m') { cw } else { spring };
+                (e.label.as_str(), l)
+            })
+            .collect();
+        setup.search_entries(&entries, 2, vec![0, 1])
+    };
+    let setup = Setup::with(model.clone(), qs.clone(), true);
+    let report = search(&setup);
+    let (cws, springs) = setup.catalogue.counts();
+    assert!(springs >= 3, "{springs} springs");
+    let n = cws + springs;
+    assert_eq!(report.designs.len(), n + n * (n - 1) / 2);
+    let mut with_springs = 0;
+    for d in &report.designs {
+        assert!(
+            d.lower_bound <= d.total_rms * (1.0 + 1e-6) + 1e-9,
+            "{:?}: bound {} above {}",
+            d.labels,
+            d.lower_bound,
+            d.total_rms
+        );
+        for s in &d.springs {
+            with_springs += 1;
+            assert!(
+                (10.0 * (1.0 - 1e-7)..=200.0 * (1.0 + 1e-7)).contains(&s.stiffness),
+                "{s:?}"
+            );
+            let (a, b) = (norm(&s.anchor_a), norm(&s.anchor_b));
+            assert!(
+                (0.05 * (1.0 - 1e-6)..=0.3 * (1.0 + 1e-6)).contains(&a),
+                "{s:?}"
+            );
+            assert!(b <= 0.2 * (1.0 + 1e-6), "{s:?}");
+        }
+        let rms = recomputed_rms(&model, &qs, d);
+        for (x, y) in rms.iter().zip(&d.rms) {
+            assert!(
+                close(*x, *y, 1e-9),
+                "{:?}: {rms:?} vs {:?}",
+                d.labels,
+                d.rms
+            );
+        }
+    }
+    assert!(with_springs > 0);
+    for w in report.designs.windows(2) {
+        assert!(w[0].total_rms <= w[1].total_rms);
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let one = pool.install(|| search(&Setup::with(model, qs, true)));
+    for (a, b) in report.designs.iter().zip(&one.designs) {
+        assert_eq!(a.labels, b.labels);
+        assert_eq!(a.total_rms.to_bits(), b.total_rms.to_bits());
+    }
+}
+
+/// The palletizer's springs-only variant `K42 + K43` balances exactly (the balance search's
+/// `balanced`, and `run` finds it feasible within the case's bounds: K ∈ [1000, 10000] N/m,
+/// |a| ∈ [0.25, 1] m, |b| ≤ 0.5 m), so within those bounds the partial search reaches no
+/// residual on any joint; either spring alone does not.
+#[test]
+fn palletizer_spring_pair_balances_within_the_bounds() {
+    let json = common::palletizer_json();
+    let model = model_of(&json);
+    let qs = grid(&[vec![0.5], spaced(0.0, 1.6, 5), spaced(0.2, 2.0, 5)]);
+    let setup = Setup::with(model, qs, true);
+    let l = spring_limits([1000.0, 10000.0], [0.25, 1.0], [0.0, 0.5]);
+    let report = setup.search_entries(&[("K42", l), ("K43", l)], 2, vec![0, 1, 2]);
+    let best = &report.designs[0];
+    assert_eq!(best.labels, ["K42", "K43"]);
+    assert!(
+        best.total_rms < 1e-5 * report.unbalanced_total,
+        "{} of {}",
+        best.total_rms,
+        report.unbalanced_total
+    );
+    assert!(best.certified);
+    let rms = recomputed_rms(&setup.model, &setup.qs, best);
+    for r in &rms {
+        assert!(*r < 1e-5 * report.unbalanced_total, "{rms:?}");
+    }
+    for d in &report.designs[1..] {
+        assert!(d.total_rms > 1e-2 * report.unbalanced_total, "{d:?}");
+    }
 }

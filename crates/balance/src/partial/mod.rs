@@ -10,12 +10,16 @@
 //! The energy, hence the torque, is linear in the lifted parameters ([`torque`]); for
 //! counterweights the bounds are convex in them too, so each set's optimum is a convex
 //! quadratic program ([`counterweights`]): its answer is the global optimum within the bounds,
-//! with clarabel's dual objective as a certified lower bound. This version covers
-//! counterweights only; springs (whose lifted parameters must also satisfy `W = αβᵀ/K`) are
-//! not part of the partial search.
+//! with clarabel's dual objective as a certified lower bound. A spring's lifted parameters must
+//! also satisfy `W = K·a·bᵀ`, which is not convex; a set with springs is solved by alternating
+//! convex programs with one anchor of every spring fixed, from several starts, and bounded
+//! below by a convex relaxation ([`springs`]): its design is realisable and within the bounds,
+//! and is called certified optimal only when it meets the bound within [`CERTIFY`] of the
+//! unbalanced torque.
 
 pub mod conic;
 pub mod counterweights;
+pub mod springs;
 pub mod torque;
 
 use rayon::prelude::*;
@@ -24,7 +28,7 @@ use serde::Serialize;
 pub use counterweights::CounterweightLimits;
 pub use torque::{TorqueBasis, Workspace};
 
-use crate::element::{Catalogue, Element};
+use crate::element::{Attachment, Catalogue, Element};
 use crate::enumerate::variants;
 use crate::realize::CounterweightParams;
 
@@ -37,7 +41,7 @@ pub enum PartialError {
     JointOutOfRange(usize, usize),
     #[error("no workspace point where the actuator Jacobian is regular")]
     NoPoints,
-    #[error("the catalogue has no counterweight (partial balancing covers counterweights only)")]
+    #[error("the catalogue has no counterweight or spring with bounds to search")]
     NoCounterweights,
     #[error("budget must be at least 1")]
     ZeroBudget,
@@ -55,17 +59,63 @@ pub struct PartialOptions {
     /// Of the designs with the least residual, take the lightest (otherwise whichever the
     /// solver ends at).
     pub lightest: bool,
+    /// Sets drawn from the springs of the catalogue too (otherwise counterweights only).
+    pub springs: bool,
 }
 
 impl PartialOptions {
-    /// The lightest design with the least residual on `joints`.
+    /// The lightest design with the least residual on `joints`, from counterweights and
+    /// springs.
     pub fn new(budget: usize, joints: Vec<usize>) -> PartialOptions {
         PartialOptions {
             budget,
             joints,
             lightest: true,
+            springs: true,
         }
     }
+}
+
+/// Bounds of one spring (the case's `balancing.bounds` with its overrides).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SpringLimits {
+    /// N/m.
+    pub stiffness: [f64; 2],
+    /// |a|, m.
+    pub anchor_a: [f64; 2],
+    /// |b|, m.
+    pub anchor_b: [f64; 2],
+    /// Per body-frame axis (x, y, z) of anchor a, `[lo, hi]` in m (infinite when free).
+    pub box_a: [[f64; 2]; 3],
+    /// The same for anchor b, in the frame of the other body (or the base).
+    pub box_b: [[f64; 2]; 3],
+}
+
+/// Bounds of one catalogue entry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ElementLimits {
+    Counterweight(CounterweightLimits),
+    Spring(SpringLimits),
+}
+
+/// A spring of a design.
+#[derive(Clone, Debug, Serialize)]
+pub struct PartialSpring {
+    pub entry: usize,
+    pub label: String,
+    /// Body of anchor a.
+    pub body: usize,
+    /// Body (or the base) of anchor b.
+    pub other: Attachment,
+    /// N/m.
+    pub stiffness: f64,
+    /// Anchor on `body`, in its frame (m).
+    pub anchor_a: [f64; 3],
+    /// Anchor on `other`, in its frame (m).
+    pub anchor_b: [f64; 3],
+    /// RMS over the workspace of the torque this spring alone exerts, `√(Σ RMS_j²)` over the
+    /// selected joints (N·m or N): how much of the balancing it does.
+    pub torque_rms: f64,
 }
 
 /// The best design of one set of elements.
@@ -76,15 +126,24 @@ pub struct PartialDesign {
     pub labels: Vec<String>,
     /// The design; a counterweight of (numerically) zero mass is listed with offset 0.
     pub counterweights: Vec<CounterweightParams>,
-    /// Labels of elements the optimum leaves at zero mass: the set is really a smaller one.
+    /// The design's springs; one of (numerically) zero stiffness is listed with anchors 0.
+    pub springs: Vec<PartialSpring>,
+    /// Labels of elements the optimum leaves at zero mass (or stiffness): the set is really a
+    /// smaller one.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub unused: Vec<String>,
     /// RMS gravity torque of every actuator over the workspace with this design (N·m or N).
     pub rms: Vec<f64>,
     /// `√(Σ RMS_j²)` over the selected joints.
     pub total_rms: f64,
-    /// A certified lower bound on `total_rms` over every design of this set within the bounds.
+    /// A certified lower bound on `total_rms` over every design of this set within the bounds
+    /// (with springs: the relaxation's).
     pub lower_bound: f64,
+    /// `total_rms − lower_bound` (at least 0; `NaN` when the bound failed).
+    pub gap: f64,
+    /// `gap ≤` [`CERTIFY`] `× unbalanced_total`: no design of the set within the bounds is
+    /// better by more than that.
+    pub certified: bool,
     /// The solver's status (`Solved`, …).
     pub status: String,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -108,8 +167,35 @@ pub struct PartialReport {
     pub designs: Vec<PartialDesign>,
 }
 
-/// A mass below this fraction of the mass bound counts as no counterweight.
+/// A mass below this fraction of the mass bound counts as no counterweight (a stiffness below
+/// it of the stiffness bound, as no spring).
 const UNUSED_MASS: f64 = 1e-6;
+
+/// A design is certified optimal when its total RMS is within this fraction of the unbalanced
+/// total of the lower bound: 0.1 % of the torque there was to remove.
+pub const CERTIFY: f64 = 1e-3;
+
+/// Spring entries of the catalogue, in catalogue order.
+pub fn spring_entries(catalogue: &Catalogue) -> Vec<usize> {
+    catalogue
+        .entries
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| matches!(e.element, Element::Spring { .. }))
+        .map(|(i, _)| i)
+        .collect()
+}
+
+/// The entries a search draws its sets from: the counterweights, then (with `springs`) the
+/// springs, in catalogue order.
+pub fn candidate_entries(catalogue: &Catalogue, springs: bool) -> Vec<usize> {
+    let mut out = counterweight_entries(catalogue);
+    if springs {
+        out.extend(spring_entries(catalogue));
+    }
+    out.sort_unstable();
+    out
+}
 
 /// Counterweight entries of the catalogue, in catalogue order.
 pub fn counterweight_entries(catalogue: &Catalogue) -> Vec<usize> {
@@ -122,9 +208,10 @@ pub fn counterweight_entries(catalogue: &Catalogue) -> Vec<usize> {
         .collect()
 }
 
-/// The number of sets [`partial_search`] solves: `Σ_{d ≤ budget} C(counterweights, d)`.
-pub fn set_count(catalogue: &Catalogue, budget: usize) -> u128 {
-    let n = counterweight_entries(catalogue).len() as u64;
+/// The number of sets [`partial_search`] solves: `Σ_{d ≤ budget} C(n, d)` over the
+/// [`candidate_entries`].
+pub fn set_count(catalogue: &Catalogue, budget: usize, springs: bool) -> u128 {
+    let n = candidate_entries(catalogue, springs).len() as u64;
     (1..=(budget as u64).min(n))
         .map(|d| crate::enumerate::binomial(n, d))
         .sum()
@@ -139,12 +226,14 @@ fn total(values: &[f64], joints: &[usize]) -> f64 {
         .sqrt()
 }
 
-/// Solves every set of at most `budget` counterweights for the least RMS gravity torque on
-/// the selected joints within `limits` (per catalogue entry; springs' are ignored).
+/// Solves every set of at most `budget` elements (counterweights, and springs with
+/// `options.springs`) for the least RMS gravity torque on the selected joints within `limits`
+/// (per catalogue entry; an entry without limits, or without torque columns in `basis`, is
+/// left out).
 pub fn partial_search(
     catalogue: &Catalogue,
     basis: &TorqueBasis,
-    limits: &[Option<CounterweightLimits>],
+    limits: &[Option<ElementLimits>],
     options: &PartialOptions,
 ) -> Result<PartialReport, PartialError> {
     if options.budget == 0 {
@@ -162,7 +251,7 @@ pub fn partial_search(
     if limits.len() != catalogue.len() {
         return Err(PartialError::BoundsLength(limits.len(), catalogue.len()));
     }
-    let candidates: Vec<usize> = counterweight_entries(catalogue)
+    let candidates: Vec<usize> = candidate_entries(catalogue, options.springs)
         .into_iter()
         .filter(|&e| limits[e].is_some() && !basis.entries[e].is_empty())
         .collect();
@@ -178,18 +267,22 @@ pub fn partial_search(
     }
     let quad = gram(basis, &columns, &options.joints);
     let unbalanced_rms = basis.rms(&[], &[]);
+    let unbalanced_total = total(&unbalanced_rms, &options.joints);
     let sets: Vec<Vec<usize>> = variants(candidates.len(), options.budget).collect();
     let mut designs: Vec<(usize, PartialDesign)> = sets
         .par_iter()
         .enumerate()
         .map(|(order, set)| {
             let design = solve_set(
-                catalogue,
-                basis,
-                limits,
-                options,
-                &quad,
-                &columns,
+                &Context {
+                    catalogue,
+                    basis,
+                    limits,
+                    options,
+                    quad: &quad,
+                    columns: &columns,
+                    unbalanced_total,
+                },
                 set.iter().map(|&i| (candidates[i], offset[i])),
             );
             (order, design)
@@ -205,7 +298,7 @@ pub fn partial_search(
         budget: options.budget,
         joints: options.joints.clone(),
         points: basis.points,
-        unbalanced_total: total(&unbalanced_rms, &options.joints),
+        unbalanced_total,
         unbalanced_rms,
         sets: sets.len(),
         designs: designs.into_iter().map(|(_, d)| d).collect(),
@@ -234,18 +327,109 @@ fn gram(basis: &TorqueBasis, columns: &[&[f64]], joints: &[usize]) -> counterwei
     counterweights::Quadratic { h, g, c }
 }
 
-/// The best design of one set: the sub-quadratic of its columns, solved; the residual
-/// recomputed from the torque columns (not from the quadratic, which loses the digits of a
-/// near-perfect balance to cancellation).
-fn solve_set(
+/// What every set's solve shares.
+struct Context<'a> {
+    catalogue: &'a Catalogue,
+    basis: &'a TorqueBasis,
+    limits: &'a [Option<ElementLimits>],
+    options: &'a PartialOptions,
+    quad: &'a counterweights::Quadratic,
+    columns: &'a [&'a [f64]],
+    unbalanced_total: f64,
+}
+
+/// `range` for the plane axes `axes` of a 3-axis box.
+fn box_of(range: &[[f64; 2]; 3], axes: &[usize]) -> Vec<[f64; 2]> {
+    axes.iter().map(|&a| range[a]).collect()
+}
+
+/// The program's block of one set element whose lifted columns start at `base` (in the set's
+/// own column order).
+fn block(
     catalogue: &Catalogue,
-    basis: &TorqueBasis,
-    limits: &[Option<CounterweightLimits>],
-    options: &PartialOptions,
-    quad: &counterweights::Quadratic,
-    columns: &[&[f64]],
-    set: impl Iterator<Item = (usize, usize)>,
-) -> PartialDesign {
+    entry: usize,
+    limits: ElementLimits,
+    base: usize,
+) -> counterweights::Block {
+    match (&catalogue.entries[entry].element, limits) {
+        (Element::Spring { axes_a, axes_b, .. }, ElementLimits::Spring(l)) => {
+            let (na, nb) = (axes_a.len(), axes_b.len());
+            let alpha = base + 1;
+            let beta = alpha + na;
+            let w = beta + nb;
+            counterweights::Block {
+                mass: base,
+                moment: (alpha..beta).collect(),
+                limits: CounterweightLimits {
+                    mass: l.stiffness,
+                    radius: l.anchor_a,
+                },
+                boxes: box_of(&l.box_a, axes_a),
+                spring: Some(counterweights::SpringColumns {
+                    beta: (beta..w).collect(),
+                    w: (w..w + na * nb).collect(),
+                    anchor_b: l.anchor_b,
+                    box_b: box_of(&l.box_b, axes_b),
+                }),
+            }
+        }
+        (Element::Counterweight { axes, .. }, ElementLimits::Counterweight(l)) => {
+            counterweights::Block {
+                mass: base,
+                moment: (base + 1..base + 1 + axes.len()).collect(),
+                limits: l,
+                boxes: Vec::new(),
+                spring: None,
+            }
+        }
+        // A limit of the other kind: the entry's own bounds are unknown, so it may not move.
+        (element, _) => {
+            let vars = match element {
+                Element::Counterweight { axes, .. } => axes.len(),
+                Element::Spring { axes_a, .. } => axes_a.len(),
+            };
+            counterweights::Block {
+                mass: base,
+                moment: (base + 1..base + 1 + vars).collect(),
+                limits: CounterweightLimits {
+                    mass: [0.0, 0.0],
+                    radius: [0.0, 0.0],
+                },
+                boxes: Vec::new(),
+                spring: None,
+            }
+        }
+    }
+}
+
+/// `√(Σ_{j ∈ joints} RMS_j²)` of the torque `Σ columns·x` alone (no unbalanced part).
+fn torque_alone(basis: &TorqueBasis, columns: &[&[f64]], x: &[f64], joints: &[usize]) -> f64 {
+    let a = basis.actuators;
+    let mut sum = 0.0;
+    for k in 0..basis.points {
+        for &j in joints {
+            let row = k * a + j;
+            let t: f64 = columns.iter().zip(x).map(|(c, xi)| c[row] * xi).sum();
+            sum += t * t;
+        }
+    }
+    (sum / basis.points.max(1) as f64).sqrt()
+}
+
+/// The best design of one set: the sub-quadratic of its columns, solved (as one convex program
+/// for counterweights, by [`springs::solve`] with springs); the residual recomputed from the
+/// torque columns (not from the quadratic, which loses the digits of a near-perfect balance to
+/// cancellation).
+fn solve_set(ctx: &Context, set: impl Iterator<Item = (usize, usize)>) -> PartialDesign {
+    let Context {
+        catalogue,
+        basis,
+        limits,
+        options,
+        quad,
+        columns,
+        unbalanced_total,
+    } = *ctx;
     let set: Vec<(usize, usize)> = set.collect();
     // The set's columns, in order, and its blocks over them.
     let mut picked = Vec::new();
@@ -254,11 +438,12 @@ fn solve_set(
         let vars = basis.entries[entry].len();
         let base = picked.len();
         picked.extend(first..first + vars);
-        blocks.push(counterweights::Block {
-            mass: base,
-            moment: (base + 1..base + vars).collect(),
-            limits: limits[entry].expect("candidates have bounds"),
-        });
+        blocks.push(block(
+            catalogue,
+            entry,
+            limits[entry].expect("candidates have bounds"),
+            base,
+        ));
     }
     let p = quad.g.len();
     let sub = counterweights::Quadratic {
@@ -269,42 +454,88 @@ fn solve_set(
         g: picked.iter().map(|&i| quad.g[i]).collect(),
         c: quad.c,
     };
-    let mut solution = counterweights::solve(&sub, &blocks, options.lightest);
-    // A counterweight left at (numerically) zero mass is not built: its lifted parameters are
-    // zeroed, so the residual below is the one of the design as reported.
+    let (mut x, lower_bound, status, note) = if blocks.iter().any(|b| b.spring.is_some()) {
+        let s = springs::solve(&sub, &blocks, options.lightest, CERTIFY * unbalanced_total);
+        (s.x, s.lower_bound, s.status, None)
+    } else {
+        let s = counterweights::solve(&sub, &blocks, options.lightest);
+        (s.x, s.lower_bound, s.status, s.note)
+    };
+    let cols: Vec<&[f64]> = picked.iter().map(|&i| columns[i]).collect();
+    // An element left at (numerically) zero mass or stiffness is not built: its lifted
+    // parameters are zeroed, so the residual below is the one of the design as reported.
     let mut params = Vec::new();
+    let mut spring_params = Vec::new();
     let mut unused = Vec::new();
     for (&(entry, _), block) in set.iter().zip(&blocks) {
-        let Element::Counterweight { body, ref axes } = catalogue.entries[entry].element else {
-            unreachable!("only counterweights are candidates");
-        };
-        let mass = solution.x[block.mass];
-        let mut offset = [0.0; 3];
-        if block.limits.mass[1] > 0.0 && mass > UNUSED_MASS * block.limits.mass[1] {
-            for (&axis, &col) in axes.iter().zip(&block.moment) {
-                offset[axis] = solution.x[col] / mass;
+        let label = &catalogue.entries[entry].label;
+        let scale = x[block.mass];
+        let used = block.limits.mass[1] > 0.0 && scale > UNUSED_MASS * block.limits.mass[1];
+        let vars = basis.entries[entry].len();
+        if !used {
+            unused.push(label.clone());
+            for v in &mut x[block.mass..block.mass + vars] {
+                *v = 0.0;
             }
-            params.push(CounterweightParams {
-                entry,
-                body,
-                mass,
-                offset,
-            });
-        } else {
-            unused.push(catalogue.entries[entry].label.clone());
-            for &col in std::iter::once(&block.mass).chain(&block.moment) {
-                solution.x[col] = 0.0;
+        }
+        match &catalogue.entries[entry].element {
+            Element::Counterweight { body, axes } => {
+                let mut offset = [0.0; 3];
+                if used {
+                    for (&axis, &col) in axes.iter().zip(&block.moment) {
+                        offset[axis] = x[col] / scale;
+                    }
+                }
+                params.push(CounterweightParams {
+                    entry,
+                    body: *body,
+                    mass: if used { scale } else { 0.0 },
+                    offset,
+                });
             }
-            params.push(CounterweightParams {
-                entry,
+            Element::Spring {
                 body,
-                mass: 0.0,
-                offset,
-            });
+                other,
+                axes_a,
+                axes_b,
+            } => {
+                let (mut anchor_a, mut anchor_b) = ([0.0; 3], [0.0; 3]);
+                if used && let Some(s) = &block.spring {
+                    for (&axis, &col) in axes_a.iter().zip(&block.moment) {
+                        anchor_a[axis] = x[col] / scale;
+                    }
+                    for (&axis, &col) in axes_b.iter().zip(&s.beta) {
+                        anchor_b[axis] = x[col] / scale;
+                    }
+                }
+                let range = block.mass..block.mass + vars;
+                spring_params.push(PartialSpring {
+                    entry,
+                    label: label.clone(),
+                    body: *body,
+                    other: *other,
+                    stiffness: if used { scale } else { 0.0 },
+                    anchor_a,
+                    anchor_b,
+                    torque_rms: torque_alone(
+                        basis,
+                        &cols[range.clone()],
+                        &x[range],
+                        &options.joints,
+                    ),
+                });
+            }
         }
     }
-    let cols: Vec<&[f64]> = picked.iter().map(|&i| columns[i]).collect();
-    let rms = basis.rms(&cols, &solution.x);
+    let rms = basis.rms(&cols, &x);
+    let total_rms = total(&rms, &options.joints);
+    // NaN (a failed bound) stays NaN: `f64::max` would make it 0.
+    let lower_bound = if lower_bound.is_nan() {
+        f64::NAN
+    } else {
+        lower_bound.max(0.0).sqrt()
+    };
+    let gap = (total_rms - lower_bound).max(0.0);
     PartialDesign {
         entries: set.iter().map(|&(e, _)| e).collect(),
         labels: set
@@ -312,11 +543,14 @@ fn solve_set(
             .map(|&(e, _)| catalogue.entries[e].label.clone())
             .collect(),
         counterweights: params,
+        springs: spring_params,
         unused,
-        total_rms: total(&rms, &options.joints),
+        total_rms,
         rms,
-        lower_bound: solution.lower_bound.sqrt(),
-        status: solution.status,
-        note: solution.note,
+        lower_bound,
+        gap,
+        certified: gap <= CERTIFY * unbalanced_total,
+        status,
+        note,
     }
 }
