@@ -13,6 +13,9 @@ use std::fmt::Write;
 
 use crate::format::escape_html;
 
+mod placement;
+use placement::Rect;
+
 /// Colour-blind-safe palette (Okabe–Ito).
 pub const PALETTE: [&str; 8] = [
     "#444444", "#0072B2", "#009E73", "#D55E00", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442",
@@ -841,8 +844,15 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
         y_lo: y_lo - dy,
         y_hi: y_hi + dy,
     };
+    let mut band_label = None;
     if let Some((a, b, label)) = &chart.band {
         let (ya, yb) = (f.y(*a), f.y(*b));
+        band_label = Some(Rect {
+            x0: left + f.w - 6.0 - text_width(label, 10.5),
+            y0: ya.max(yb) - 3.0 - 9.0,
+            x1: left + f.w - 6.0,
+            y1: ya.max(yb) - 3.0 + 2.0,
+        });
         let _ = write!(
             out,
             r##"<rect x="{left:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="#fff3cd"/><text x="{:.1}" y="{:.1}" font-size="10.5" fill="#7a5b00" text-anchor="end">{}</text>"##,
@@ -899,6 +909,9 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
     // Count labels that would overprint another are left out (the tooltip still lists the
     // group).
     let mut counts: Vec<(f64, f64)> = Vec::new();
+    // What the callouts must not overprint: markers, counts, the band's label, then rings and
+    // the callouts themselves.
+    let mut obstacles: Vec<Rect> = band_label.into_iter().collect();
     for (_, _, g) in &groups {
         let big = g
             .iter()
@@ -918,12 +931,20 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
         };
         let _ = write!(out, "<g><title>{}</title>", escape_html(&tip));
         marker(&mut out, big.marker, x, y, r, &big.color, false);
+        // Triangles and diamonds reach 1.2 r above or below their centre.
+        obstacles.push(Rect::around(x, y, r + 1.0, 1.2 * r + 1.0));
         let (cx, cy) = (x + r + 2.0, y - r + 2.0);
         let free = counts
             .iter()
             .all(|&(px, py)| (px - cx).abs() > 24.0 || (py - cy).abs() > 11.0);
         if g.len() > 2 && free {
             counts.push((cx, cy));
+            obstacles.push(Rect {
+                x0: cx,
+                y0: cy - 8.0,
+                x1: cx + text_width(&format!("×{}", g.len()), 10.0),
+                y1: cy + 2.0,
+            });
             let _ = write!(
                 out,
                 r##"<text x="{cx:.1}" y="{cy:.1}" font-size="10" fill="#333333">×{}</text>"##,
@@ -953,53 +974,61 @@ pub fn scatter_chart(chart: &ScatterChart) -> String {
             None => callouts.push((x, y, r, text)),
         }
     }
-    let mut placed: Vec<(f64, f64, f64, f64)> = Vec::new();
+    // Each label goes where it overprints no marker, ring, count or other label
+    // ([`placement`]); a label moved away from its point is tied to the ring by a leader.
+    for (x, y, r, _) in &callouts {
+        obstacles.push(Rect::around(*x, *y, r + 1.0, r + 1.0));
+    }
+    let bounds = Rect {
+        x0: left,
+        y0: top,
+        x1: left + f.w,
+        y1: top + f.h,
+    };
     let mut cards = String::new();
     for (x, y, r, text) in &callouts {
         let tw = text_width(text, SMALL);
-        let right_side = x + r + 4.0 + tw < left + f.w;
-        let (tx, anchor, x0) = if right_side {
-            (x + r + 4.0, "start", x + r + 4.0)
-        } else {
-            (x - r - 4.0, "end", x - r - 4.0 - tw)
-        };
-        let mut ty = y + 4.0;
-        // Move down (or up near the bottom) until clear of the labels already placed.
-        let clear = |ty: f64, placed: &[(f64, f64, f64, f64)]| {
-            placed.iter().all(|&(px0, py, pw, _)| {
-                (ty - py).abs() >= SMALL + 2.0 || x0 + tw <= px0 || x0 >= px0 + pw
-            })
-        };
-        let step = if ty + 40.0 > top + f.h {
-            -(SMALL + 2.0)
-        } else {
-            SMALL + 2.0
-        };
-        let mut guard = 0;
-        while !clear(ty, &placed) && guard < 20 {
-            ty += step;
-            guard += 1;
-        }
-        placed.push((x0, ty, tw, 0.0));
-        // A white card under the text hides the front's dashed step, which runs at the point's
-        // height through the label's middle (a halo alone leaves it showing between the
-        // letters); drawn under the markers, it hides no point (bold text runs about 10 % wider
-        // than the estimate, hence the wider card).
+        // A white card under the text hides the front's dashed step where it runs through
+        // the label (a halo alone leaves it showing between the letters); bold text runs
+        // about 10 % wider than the estimate, hence the wider card, which is also the box
+        // kept clear of everything else.
         let card = tw * 1.12 + 4.0;
-        let card_x = if right_side {
-            x0 - 2.0
+        let b = placement::place(*x, *y, *r, card, SMALL + 3.0, &obstacles, &bounds);
+        obstacles.push(b);
+        // The text hugs the side of the card nearest the point.
+        let (tx, anchor) = if b.x0 >= *x {
+            (b.x0 + 2.0, "start")
+        } else if b.x1 <= *x {
+            (b.x1 - 2.0, "end")
         } else {
-            x0 + tw + 2.0 - card
+            ((b.x0 + b.x1) / 2.0, "middle")
         };
+        let ty = b.y0 + 0.8 * SMALL + 1.0;
         let _ = write!(
             cards,
-            r##"<rect x="{card_x:.1}" y="{:.1}" width="{card:.1}" height="{:.1}" fill="#ffffff" class="card"/>"##,
-            ty - 0.8 * SMALL - 1.0,
+            r##"<rect x="{:.1}" y="{:.1}" width="{card:.1}" height="{:.1}" fill="#ffffff" class="card"/>"##,
+            b.x0,
+            b.y0,
             SMALL + 3.0,
         );
         let _ = write!(
             out,
-            r##"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="none" stroke="#111111" stroke-width="1.6"/><text x="{tx:.1}" y="{ty:.1}" font-size="{SMALL}" font-weight="600" text-anchor="{anchor}" stroke="#ffffff" stroke-width="3" paint-order="stroke">{}</text>"##,
+            r##"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="none" stroke="#111111" stroke-width="1.6"/>"##
+        );
+        if b.distance(*x, *y) > r + placement::GAP + placement::CLEARANCE + 1.0 {
+            // From the ring's edge towards the nearest point of the card.
+            let (nx, ny) = (x.clamp(b.x0, b.x1), y.clamp(b.y0, b.y1));
+            let d = (nx - x).hypot(ny - y).max(1e-9);
+            let _ = write!(
+                out,
+                r##"<line x1="{:.1}" y1="{:.1}" x2="{nx:.1}" y2="{ny:.1}" stroke="#111111" stroke-width="0.8" class="leader"/>"##,
+                x + (nx - x) * r / d,
+                y + (ny - y) * r / d
+            );
+        }
+        let _ = write!(
+            out,
+            r##"<text x="{tx:.1}" y="{ty:.1}" font-size="{SMALL}" font-weight="600" text-anchor="{anchor}" stroke="#ffffff" stroke-width="3" paint-order="stroke" class="callout">{}</text>"##,
             escape_html(text)
         );
     }
