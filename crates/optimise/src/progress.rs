@@ -91,6 +91,10 @@ pub struct ShareCounter<'a> {
     stage: &'static str,
     pass: usize,
     variants: usize,
+    /// The largest share sent: a report that does not raise it is dropped, so the sink hears
+    /// at most [`SHARE_SCALE`] reports per stage (a batch through the direct path has one unit
+    /// per task, 58,653 on the palletizer) and never a share going back.
+    sent: AtomicUsize,
 }
 
 impl<'a> ShareCounter<'a> {
@@ -106,6 +110,7 @@ impl<'a> ShareCounter<'a> {
             stage,
             pass,
             variants,
+            sent: AtomicUsize::new(0),
         };
         counter.send(0);
         counter
@@ -122,7 +127,10 @@ impl<'a> ShareCounter<'a> {
             done.min(total) as f64 / total as f64
         };
         let share = (before as f64 + members as f64 * within) / variants;
-        self.send(((share * SHARE_SCALE as f64).floor() as usize).min(SHARE_SCALE));
+        let done = ((share * SHARE_SCALE as f64).floor() as usize).min(SHARE_SCALE);
+        if self.sent.fetch_max(done, Ordering::Relaxed) < done {
+            self.send(done);
+        }
     }
 
     fn send(&self, done: usize) {
@@ -168,6 +176,8 @@ mod tests {
         let counter = ShareCounter::start(&sink, "final evaluation", 0, 4);
         // One variant in a batch of 10 units, then three in a batch of 4 units.
         counter.batch(0, 1, 5, 10); // half of 1/4: 125 thousandths
+        counter.batch(0, 1, 5, 10); // the same share again: not sent
+        counter.batch(0, 1, 4, 10); // a thread reporting late: not sent
         counter.batch(0, 1, 10, 10); // 1/4
         counter.batch(1, 3, 2, 4); // 1/4 + 3/4 · 1/2 = 5/8
         counter.batch(1, 3, 4, 4); // all
