@@ -10,7 +10,8 @@
 //! bounds. It stops at a point where neither anchor can improve alone, which need not be the
 //! optimum: `b = 0` is such a point for a spring that does nothing there. So the alternation
 //! runs from several deterministic starts — anchor b from the relaxation's `W` (its leading
-//! right singular vector), then along each plane axis of b in both directions at full radius —
+//! right singular vector), then along each plane axis of b in both directions at full radius,
+//! then (for a spring in a plane) along the four diagonals —
 //! and keeps the best, stopping early once the design meets the lower bound.
 //!
 //! The lower bound is the relaxation: `K·a`, `K·b`, `W` free under `‖K·a‖ ≤ a_hi·K`,
@@ -81,8 +82,9 @@ fn leading_right(w: &[f64], na: usize, nb: usize) -> (f64, Vec<f64>) {
     (s.max(0.0), vt.row(k).iter().copied().collect())
 }
 
-/// The starts: the relaxation's anchors first, then every axis of b in both directions, the
-/// same for every spring of the set; duplicates dropped, order kept.
+/// The starts: the relaxation's anchors first, then every axis of b in both directions, then in
+/// the plane the diagonals, the same for every spring of the set; duplicates dropped, order
+/// kept.
 fn starts(blocks: &[Block], relaxed: &Solution) -> Vec<Anchors> {
     let mut out: Vec<Anchors> = Vec::new();
     let from_relaxation: Anchors = blocks
@@ -124,6 +126,24 @@ fn starts(blocks: &[Block], relaxed: &Solution) -> Vec<Anchors> {
                     let s = b.spring.as_ref()?;
                     let dir: Vec<f64> = (0..s.beta.len())
                         .map(|i| if i == l { sign } else { 0.0 })
+                        .collect();
+                    Some(at_radius(&dir, s.anchor_b[1], &s.box_b))
+                })
+                .collect();
+            out.push(start);
+        }
+    }
+    // In the plane, the four diagonals too: on the palletizer they improve 41 of the 406 sets
+    // of budget 2 (up to 10 %, none worse) at twice the time; in space (twelve more starts) they
+    // improved 3 of the 6-axis arm's 378 sets by under 0.1 % at three times the time.
+    if axes == 2 {
+        for (s0, s1) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+            let start: Anchors = blocks
+                .iter()
+                .map(|b| {
+                    let s = b.spring.as_ref()?;
+                    let dir: Vec<f64> = (0..s.beta.len())
+                        .map(|i| [s0, s1].get(i).copied().unwrap_or(0.0))
                         .collect();
                     Some(at_radius(&dir, s.anchor_b[1], &s.box_b))
                 })
