@@ -276,7 +276,7 @@ pub fn solve_shaped(
 /// the singular values are `|C| ± |A|`, so the nuclear norm is `2·max(|C|, |A|)`, i.e.
 /// `‖(W00 + W11, W10 − W01)‖ ≤ c·K` and `‖(W00 − W11, W01 + W10)‖ ≤ c·K`. For a rank-one
 /// `W = K·a·bᵀ` both hold with `c = |a|·|b|`, and every 2 × 2 block of a matrix has a nuclear
-/// norm at most the matrix's: a valid cut, tight in the plane.
+/// norm at most the matrix's: a valid cut, and for a plane spring the whole nuclear norm.
 fn nuclear_2x2(w: [usize; 4]) -> [[(usize, f64); 2]; 4] {
     let [w00, w01, w10, w11] = w;
     [

@@ -16,7 +16,8 @@
 //!
 //! The lower bound is the relaxation: `K·a`, `K·b`, `W` free under `‖K·a‖ ≤ a_hi·K`,
 //! `‖K·b‖ ≤ b_hi·K`, `‖W‖_F ≤ a_hi·b_hi·K` and the nuclear norm of every 2 × 2 block of `W`
-//! below `a_hi·b_hi·K` (exact for a plane spring), its dual objective a certified bound on every
+//! below `a_hi·b_hi·K` (exact where only `W` reaches the torque, as for a plane spring from the
+//! base to a link about its pivot), its dual objective a certified bound on every
 //! design of the set. Where the relaxation is tight the design is certified optimal; otherwise
 //! the gap is reported.
 
