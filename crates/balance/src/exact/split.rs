@@ -211,7 +211,16 @@ mod tests {
     /// One spring `(K, αx, αy, βx, βy, Wxx, Wxy, Wyx, Wyy)` with the balance rows given as
     /// `(variable, right-hand side)`: `x_variable = value`.
     fn rectangles_of(rows: &[(usize, i64)]) -> Vec<(Vec<usize>, Vec<usize>)> {
-        let entry = CatalogueEntry {
+        let entry = spring();
+        let solution = solved(rows);
+        rectangles(&solution, &[(0, &entry)])
+            .into_iter()
+            .map(|r| (r.rows, r.columns))
+            .collect()
+    }
+
+    fn spring() -> CatalogueEntry {
+        CatalogueEntry {
             element: Element::Spring {
                 body: 0,
                 other: Attachment::Base,
@@ -222,7 +231,11 @@ mod tests {
             description: "spring".into(),
             variables: Vec::new(),
             energy: Vec::new(),
-        };
+        }
+    }
+
+    /// The one-spring variant solved with the balance rows `x_variable = value`.
+    fn solved(rows: &[(usize, i64)]) -> ExactSolution<Rational> {
         let mut columns = vec![vec![BigInt::from(0); rows.len()]; 9];
         for (r, &(j, _)) in rows.iter().enumerate() {
             columns[j][r] = BigInt::from(1);
@@ -233,11 +246,47 @@ mod tests {
             elements: vec![columns],
             row_factors: vec![Rational::from_integer(1.into()); rows.len()],
         };
-        let solution = basis.solve(&[0]);
-        rectangles(&solution, &[(0, &entry)])
-            .into_iter()
-            .map(|r| (r.rows, r.columns))
+        basis.solve(&[0])
+    }
+
+    /// The variables a branch sets to zero (each row is a unit row).
+    fn zeroed(rows: &[Vec<Rational>]) -> Vec<usize> {
+        let zero = Rational::from_integer(0.into());
+        rows.iter()
+            .map(|row| {
+                assert_eq!(row.iter().filter(|v| **v != zero).count(), 1);
+                row.iter().position(|v| *v != zero).unwrap()
+            })
             .collect()
+    }
+
+    #[test]
+    fn a_branch_zeroes_the_anchor_part_and_its_whole_row_or_column_of_w() {
+        // Variables 0 K, 1 αx, 2 αy, 3 βx, 4 βy, 5 Wxx, 6 Wxy, 7 Wyx, 8 Wyy (W_ij at 5 + 2i + j).
+        let entry = spring();
+        let solution = solved(&[(0, 1)]);
+        let block = Rectangle {
+            k: 0,
+            rows: vec![1],
+            columns: vec![0],
+        };
+        // a's y part zero: αy and the row y of W, (Wyx, Wyy) = variables 7, 8.
+        let side_a = branch_rows(&solution, &[(0, &entry)], &block, true);
+        assert_eq!(zeroed(&side_a), vec![2, 7, 8]);
+        // b's x part zero: βx and the column x of W, (Wxx, Wyx) = variables 5, 7.
+        let side_b = branch_rows(&solution, &[(0, &entry)], &block, false);
+        assert_eq!(zeroed(&side_b), vec![3, 5, 7]);
+        // The other corner: a's x part (αx; Wxx, Wxy), b's y part (βy; Wxy, Wyy).
+        let corner = Rectangle {
+            k: 0,
+            rows: vec![0],
+            columns: vec![1],
+        };
+        let side_a = branch_rows(&solution, &[(0, &entry)], &corner, true);
+        assert_eq!(zeroed(&side_a), vec![1, 5, 6]);
+        let side_b = branch_rows(&solution, &[(0, &entry)], &corner, false);
+        assert_eq!(zeroed(&side_b), vec![4, 6, 8]);
+        assert!(side_b.iter().all(|row| row.len() == 9));
     }
 
     #[test]
