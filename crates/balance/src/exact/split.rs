@@ -307,6 +307,8 @@ mod tests {
         assert!(rectangles_of(&[(0, 1), (5, 0), (1, 0)]).is_empty());
         // Likewise with βx = 0.
         assert!(rectangles_of(&[(0, 1), (5, 0), (3, 0)]).is_empty());
+        // Wxy = 0 with βy (variable 4) = 0 already: the block {x}×{y} says nothing either.
+        assert!(rectangles_of(&[(0, 1), (6, 0), (4, 0)]).is_empty());
         // Wxx = 1: nothing is zero.
         assert!(rectangles_of(&[(0, 1), (5, 1)]).is_empty());
     }
