@@ -6,6 +6,7 @@ use std::fmt::Write;
 
 use crate::charts::{self, Chart, Section};
 use crate::format::{escape_html as esc, value};
+use crate::partial::{self, PartialBalancing};
 use crate::results::{RunResults, VariantStatus};
 use crate::tables::{self, Table};
 
@@ -25,6 +26,7 @@ table { border-collapse: collapse; margin: 6px 0 14px; font-variant-numeric: tab
 th, td { padding: 4px 10px; border-bottom: 1px solid var(--line); text-align: left; vertical-align: top; }
 td { white-space: nowrap; }
 td.p { white-space: normal; min-width: 220px; }
+table.partial td.p { min-width: 340px; }
 th { background: var(--band); font-weight: 600; vertical-align: bottom; }
 .scroll { overflow-x: auto; max-width: 100%; }
 .scroll.tall { max-height: 70vh; overflow-y: auto; border: 1px solid var(--line); }
@@ -83,6 +85,10 @@ pub fn render(r: &RunResults) -> String {
     if tables::recommendations(r).rows.is_empty() && !r.schematics.is_empty() {
         h.push_str("<h2>The mechanism</h2><p class=\"note\">No variant to recommend; the mechanism as the case describes it.</p>");
         push_schematics(&mut h, r, "");
+    }
+
+    if let Some(p) = &r.partial {
+        push_partial(&mut h, p);
     }
 
     h.push_str("<h2>Summary</h2>");
@@ -606,6 +612,21 @@ pub(crate) fn capitalise(s: &str) -> String {
     match c.next() {
         Some(f) => f.to_uppercase().chain(c).collect(),
         None => String::new(),
+    }
+}
+
+/// The partial-balancing section (see [`crate::partial`]): the smallest-Dmax statement, the
+/// chart and the designs table.
+fn push_partial(h: &mut String, p: &PartialBalancing) {
+    h.push_str("<h2 id=\"partial\">Partial balancing (no feasible variant)</h2>");
+    for paragraph in partial::paragraphs(p) {
+        let _ = write!(h, "<p class=\"note\">{}</p>", esc(&paragraph));
+    }
+    if let Some(svg) = partial::chart(p) {
+        let _ = write!(h, "<div class=\"charts\"><figure>{svg}</figure></div>");
+    }
+    if !p.designs.is_empty() {
+        h.push_str(&table(&partial::table(p), "partial"));
     }
 }
 

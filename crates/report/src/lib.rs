@@ -43,7 +43,8 @@
 //!
 //! Modules, one job each: [`indicators`] (Eqs. 15–21), [`ranking`] (lexicographic order at a
 //! resolution), [`practical`] (added mass, element count, spring and offset peaks),
-//! [`decision`] (equivalence groups and recommendations), [`honest`] (idle elements,
+//! [`decision`] (equivalence groups and recommendations), [`partial`] (the partial balancing
+//! when nothing is feasible), [`honest`] (idle elements,
 //! parameters on a bound), [`schematic`] (drawings of variants), [`springspec`] (what to order
 //! for each spring), [`results`] (the schema and
 //! `finalize`), [`tables`] (the tables both reports
@@ -61,6 +62,7 @@ pub mod indicators;
 pub mod labels;
 pub mod markdown;
 pub mod output;
+pub mod partial;
 pub mod practical;
 pub mod ranking;
 pub mod results;
@@ -79,6 +81,7 @@ pub use output::{
     OutputError, read_results, regenerate, regenerate_with, write_atomic, write_outputs,
     write_reports,
 };
+pub use partial::{PartialBalancing, PartialDesign, PartialElement};
 pub use practical::{PracticalFigures, SpringPeak};
 pub use ranking::{Class, RankItem, Ranking, RankingError, RankingOptions, rank};
 pub use results::{

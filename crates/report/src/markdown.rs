@@ -45,6 +45,16 @@ pub fn render(r: &RunResults) -> String {
             "The Pareto chart (ΔQTR against added mass, ΔR as marker size) is in report.html.\n\n",
         );
     }
+    if let Some(p) = &r.partial {
+        let _ = writeln!(s, "## Partial balancing (no feasible variant)\n");
+        for paragraph in crate::partial::paragraphs(p) {
+            let _ = writeln!(s, "{}\n", esc(&paragraph));
+        }
+        if !p.designs.is_empty() {
+            table(&mut s, &crate::partial::table(p));
+            s.push_str("The chart of the RMS per actuator is in report.html.\n\n");
+        }
+    }
     section(&mut s, "Summary", &tables::best_per_class(r));
     s.push_str(
         "ΔQTR and ΔQIT are percentage variations with respect to the unbalanced robot \

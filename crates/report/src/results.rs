@@ -571,6 +571,10 @@ pub struct RunResults {
     /// path (filled by the caller): flat for a balanced variant.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub energy: Option<EnergyChart>,
+    /// What `run` found when no variant is feasible: the smallest Dmax that balances and the
+    /// best partial balancing (filled by the caller; see [`crate::partial`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub partial: Option<crate::partial::PartialBalancing>,
 }
 
 /// Potential energy (gravity and springs) along one motion, relative to its first sample, per
@@ -608,6 +612,7 @@ impl RunResults {
             element_bounds: Vec::new(),
             schematics: Vec::new(),
             energy: None,
+            partial: None,
         }
     }
 

@@ -584,8 +584,14 @@ pub struct BarChart {
     pub height: f64,
 }
 
-/// Renders a grouped bar chart as an `<svg>` element.
+/// Renders a grouped bar chart of percentages as an `<svg>` element.
 pub fn bar_chart(chart: &BarChart) -> String {
+    bar_chart_in(chart, "%", crate::format::percent)
+}
+
+/// [`bar_chart`] of values in `unit` (`N·m`), each written by `number` in its tooltip (with the
+/// unit) and beside a clipped bar.
+pub fn bar_chart_in(chart: &BarChart, unit: &str, number: fn(f64) -> String) -> String {
     let n_series = chart.series.len().max(1);
     let bar = 16.0;
     let label_w = chart
@@ -680,12 +686,13 @@ pub fn bar_chart(chart: &BarChart) -> String {
             let bx = bars_x + s as f64 * bar;
             let _ = write!(
                 out,
-                r#"<rect x="{bx:.1}" y="{ry:.1}" width="{:.1}" height="{:.1}" fill="{color}"><title>{} {}: {} %</title></rect>"#,
+                r#"<rect x="{bx:.1}" y="{ry:.1}" width="{:.1}" height="{:.1}" fill="{color}"><title>{} {}: {} {}</title></rect>"#,
                 bar - 2.0,
                 rh.max(0.5),
                 escape_html(name),
                 escape_html(label),
-                crate::format::percent(v)
+                number(v),
+                escape_html(unit)
             );
             if drawn != v {
                 // A white zigzag across the bar near its end, and the true value beyond it.
@@ -704,7 +711,7 @@ pub fn bar_chart(chart: &BarChart) -> String {
                     zy - 3.0,
                     bx + (bar - 2.0) / 2.0,
                     if v > 0.0 { edge - 4.0 } else { edge + 12.0 },
-                    escape_html(&crate::format::percent(v))
+                    escape_html(&number(v))
                 );
             }
         }

@@ -2,27 +2,48 @@
 //! to balance at all, and the best it gets from the elements it was given — the partial
 //! balancing of [`super::compute`] with the study's Dmax as the budget, every actuator's torque
 //! minimised. The results go to `partial.json` and `partial.csv` beside `results.json`, a note in
-//! `results.json`'s metadata (which the reports print) and a block in the terminal summary; the
-//! report crate has no partial section of its own.
+//! `results.json`'s metadata, a block in the terminal summary, and the reports' partial-balancing
+//! section ([`counterpoise_report::partial`], given the same numbers as plain data).
 
 use std::fmt::Write as _;
 
 use anyhow::Result;
-use counterpoise_balance::minimal::minimal_search;
+use counterpoise_balance::exact::ExactField;
+use counterpoise_balance::linear::LiftedBasis;
+use counterpoise_balance::minimal::minimal_sets;
 use counterpoise_balance::partial::counterweight_entries;
+use counterpoise_balance::search::decide;
 use counterpoise_balance::{
-    Catalogue, SearchOptions, SearchReport, Status, VariantResult, catalogue_options,
+    Catalogue, SearchReport, Status, VariantResult, VerificationSet, catalogue_options,
     mechanism_energy, realization_hints,
 };
 use counterpoise_model::Model;
+use counterpoise_report::{PartialBalancing, PartialDesign, PartialElement};
+use counterpoise_symbolic::Rational;
+use rayon::prelude::*;
 use serde_json::json;
 
 use super::{Computed, change, compute, design_line, set_guard};
 
-/// How far past the study's Dmax the minimal-set walk looks for the smallest Dmax at which a
-/// variant balances: two more elements (the 6-axis arm of `cases/arm6.json` needs one more than
-/// its Dmax 2, found in about 10 s), within the `--minimal` guard.
+/// How far past the study's Dmax the search for the smallest Dmax at which a variant balances
+/// looks: two more elements (the 6-axis arm of `cases/arm6.json` needs one more than its
+/// Dmax 2), each size within the `--minimal` guard.
 pub const PROBE_BEYOND: usize = 2;
+
+/// Most sets decided in full (witness search or proof) past the study's Dmax when looking for
+/// the smallest Dmax. The statement needs one balanced example, not every one: the search stops
+/// at the first, and this budget bounds the cost when the first comes late or never (about
+/// 50 ms per set on the arm; `variants CASE --minimal` decides them all).
+pub const DECISION_BUDGET: usize = 1_000;
+
+/// Most candidate sets of one size collected from the minimal sets (a bound on memory: the
+/// supersets of many small minimal sets grow as C(n, d)). Past it, the first candidates in the
+/// walk's order are kept and the statement says so.
+pub const CANDIDATE_CAP: usize = 200_000;
+
+/// Sets decided together, in parallel. Fixed, so that the sets decided and the example found
+/// (the first balanced set in lexicographic order) are the same for every thread count.
+const CHUNK: usize = 8;
 
 /// File names beside `results.json`.
 pub const PARTIAL_JSON: &str = "partial.json";
@@ -39,6 +60,8 @@ pub struct Fallback {
     pub text: String,
     pub json: serde_json::Value,
     pub csv: String,
+    /// The reports' partial-balancing section (the same numbers as `json`).
+    pub section: PartialBalancing,
 }
 
 /// The smallest Dmax at which a variant balances, as far as it was looked for.
@@ -65,9 +88,97 @@ fn labels(v: &VariantResult) -> String {
         .join(" + ")
 }
 
+/// What the probe of one size found.
+enum Probe {
+    /// The first balanced set in lexicographic order.
+    Balanced(Box<VariantResult>),
+    /// None of the candidates balances (`undecided` of them undecided).
+    None { undecided: usize },
+    /// The decision budget ran out before every candidate was decided.
+    Budget { candidates: usize, capped: bool },
+}
+
+/// The sets of exactly `size` elements whose balance equations are solvable: by monotonicity,
+/// the minimal sets of that size and the supersets of the smaller ones. Sets with an element
+/// whose energy is identically constant are left out: such an element changes nothing, so the
+/// set balances only if the set without it does, and every smaller set was already decided
+/// without a balanced one. Sorted (lexicographic order of the sorted entries); `true` when
+/// [`CANDIDATE_CAP`] cut the list.
+fn candidates(minimal: &[Vec<usize>], constant: &[bool], size: usize) -> (Vec<Vec<usize>>, bool) {
+    let mut sets = std::collections::BTreeSet::new();
+    for m in minimal.iter().filter(|m| m.len() <= size) {
+        let rest: Vec<usize> = (0..constant.len())
+            .filter(|e| !constant[*e] && !m.contains(e))
+            .collect();
+        let k = size - m.len();
+        if k > rest.len() {
+            continue;
+        }
+        // The k-combinations of `rest` in lexicographic order, as index vectors.
+        let mut pick: Vec<usize> = (0..k).collect();
+        loop {
+            let mut s = m.clone();
+            s.extend(pick.iter().map(|&i| rest[i]));
+            s.sort_unstable();
+            sets.insert(s);
+            if sets.len() >= CANDIDATE_CAP {
+                return (sets.into_iter().collect(), true);
+            }
+            let Some(i) = (0..k).rev().find(|&i| pick[i] < rest.len() - k + i) else {
+                break;
+            };
+            pick[i] += 1;
+            for j in i + 1..k {
+                pick[j] = pick[j - 1] + 1;
+            }
+        }
+    }
+    (sets.into_iter().collect(), false)
+}
+
+/// Decides `sets` in order, [`CHUNK`] at a time, until the first balanced one or the budget
+/// (`left`, decremented by each decision) runs out.
+fn probe(
+    sets: &[Vec<usize>],
+    capped: bool,
+    left: &mut usize,
+    decide: &(dyn Fn(&[usize]) -> VariantResult + Sync),
+) -> Probe {
+    let mut undecided = 0;
+    for chunk in sets.chunks(CHUNK) {
+        if *left == 0 {
+            return Probe::Budget {
+                candidates: sets.len(),
+                capped,
+            };
+        }
+        let chunk = &chunk[..chunk.len().min(*left)];
+        *left -= chunk.len();
+        let results: Vec<VariantResult> = chunk.par_iter().map(|s| decide(s)).collect();
+        for v in results {
+            match v.status {
+                Status::Balanced => return Probe::Balanced(Box::new(v)),
+                Status::Undecided => undecided += 1,
+                _ => {}
+            }
+        }
+    }
+    if capped {
+        return Probe::Budget {
+            candidates: sets.len(),
+            capped,
+        };
+    }
+    Probe::None { undecided }
+}
+
 /// From the study's own search when something balances within its Dmax (then the bounds or the
-/// peak limits are what excluded it); otherwise from the minimal-set walk up to
-/// Dmax + [`PROBE_BEYOND`] (an exact case only).
+/// peak limits are what excluded it); otherwise size by size past the study's Dmax, up to
+/// Dmax + [`PROBE_BEYOND`] (an exact case only): the minimal-set walk to that size, then the
+/// solvable sets of that size decided in lexicographic order until the first that balances
+/// with verified parameters. The study's search decided every set up to its Dmax, and each
+/// size is searched to the end before the next, so the first size with a balanced set is the
+/// smallest Dmax.
 fn smallest(model: &Model, dmax: usize, found: &SearchReport) -> Smallest {
     let within = plural(dmax, "element");
     let realizable: Vec<&VariantResult> = found
@@ -89,87 +200,124 @@ fn smallest(model: &Model, dmax: usize, found: &SearchReport) -> Smallest {
             json: json!({ "searched_to": dmax, "smallest_balanced": size, "source": "run" }),
         };
     }
+    let not_looked = |why: &str| Smallest {
+        sentence: format!("no variant of at most {within} balances; {why}"),
+        json: json!({ "searched_to": dmax, "smallest_balanced": null, "source": "run" }),
+    };
     let energy = mechanism_energy(model);
     let catalogue = Catalogue::build(&energy, &catalogue_options(model));
-    let exact = match &energy.exact {
-        Ok(mechanism) => counterpoise_balance::exact::ExactBasis::build(mechanism, &catalogue),
-        Err(_) => {
-            return Smallest {
-                sentence: format!(
-                    "no variant of at most {within} balances; the smallest Dmax that does \
-                     was not looked for (the minimal-set walk needs an exact case)"
-                ),
-                json: json!({ "searched_to": dmax, "smallest_balanced": null, "source": "run" }),
-            };
-        }
+    let basis = LiftedBasis::build(&energy, &catalogue);
+    let Some(exact) = &basis.exact else {
+        return not_looked(
+            "the smallest Dmax that does was not looked for (the minimal-set walk needs an \
+             exact case)",
+        );
     };
-    // The deepest probe the `--minimal` guard allows.
-    let probe = (dmax + 1..=dmax + PROBE_BEYOND)
-        .rev()
-        .find(|&d| super::super::variants::minimal_guard(&exact, d, "--dmax").is_ok());
-    let Some(probe) = probe else {
-        return Smallest {
-            sentence: format!(
-                "no variant of at most {within} balances; a deeper search is past the \
-                 limits (`variants CASE --minimal --dmax N`)"
-            ),
-            json: json!({ "searched_to": dmax, "smallest_balanced": null, "source": "run" }),
-        };
-    };
-    let report = match minimal_search(
-        &energy,
-        catalogue,
-        SearchOptions {
-            dmax: probe,
-            hints: realization_hints(model),
-        },
-    ) {
-        Ok(r) => r,
-        Err(e) => {
-            return Smallest {
-                sentence: format!(
-                    "no variant of at most {within} balances; the minimal-set walk failed: \
-                     {e}"
-                ),
-                json: json!({ "searched_to": dmax, "smallest_balanced": null, "source": "run" }),
-            };
+    let checks = VerificationSet::new(&energy);
+    let hints = realization_hints(model);
+    let decide_set = |set: &[usize]| decide(&energy, &catalogue, &basis, &checks, set, hints);
+    let constant: Vec<bool> = exact
+        .elements
+        .iter()
+        .map(|columns| columns.iter().flatten().all(Rational::entry_is_zero))
+        .collect();
+    let mut left = DECISION_BUDGET;
+    let mut smallest_linear = None;
+    let mut undecided = 0;
+    let mut searched_to = dmax;
+    for size in dmax + 1..=dmax + PROBE_BEYOND {
+        if super::super::variants::minimal_guard(exact, size, "--dmax").is_err() {
+            break;
         }
-    };
-    let json = json!({
-        "searched_to": probe,
-        "smallest_linear": report.smallest_linear,
-        "smallest_balanced": report.smallest_balanced,
-        "note": report.smallest_balanced_note,
-        "source": "variants --minimal",
-    });
-    let sentence = match report.smallest_balanced {
-        Some(d) => {
-            let example = report
-                .sets
-                .iter()
-                .filter(|v| v.status == Status::Balanced && v.elements.len() == d)
-                .chain(&report.first_balanced)
-                .next()
-                .map_or(String::new(), |v| format!(", e.g. {}", labels(v)));
-            let at_most = if report.smallest_balanced_note.is_some() {
-                "at most "
-            } else {
-                ""
-            };
-            format!(
-                "no variant of at most {within} balances; the smallest Dmax at which one \
-                 does is {at_most}{d}{example} (`variants CASE --minimal --dmax {probe}`)"
-            )
+        let walk = minimal_sets(exact, size);
+        smallest_linear = walk.minimal.iter().map(Vec::len).min();
+        let (sets, capped) = candidates(&walk.minimal, &constant, size);
+        let outcome = probe(&sets, capped, &mut left, &decide_set);
+        let decided = DECISION_BUDGET - left;
+        match outcome {
+            Probe::Balanced(v) => {
+                let names: Vec<&str> = v.elements.iter().map(|e| e.label.as_str()).collect();
+                return Smallest {
+                    sentence: format!(
+                        "no variant of at most {within} balances; the smallest Dmax at which one \
+                         does is {size}, e.g. {} (`variants CASE --minimal --dmax {size}` lists \
+                         every one)",
+                        labels(&v)
+                    ),
+                    json: json!({
+                        "searched_to": size,
+                        "smallest_linear": smallest_linear,
+                        "smallest_balanced": size,
+                        "example": names,
+                        "decided": decided,
+                        "undecided": undecided,
+                        "note": null,
+                        "source": "variants --minimal",
+                    }),
+                };
+            }
+            Probe::Budget { candidates, capped } => {
+                let note = format!(
+                    "the budget of {DECISION_BUDGET} decisions past Dmax {dmax} ran out among \
+                     the {}{} sets of {} whose balance equations are solvable, none of those \
+                     decided balancing",
+                    if capped { "first " } else { "" },
+                    candidates,
+                    plural(size, "element")
+                );
+                return Smallest {
+                    sentence: format!(
+                        "no variant of at most {} balances; the smallest Dmax at which one does \
+                         is at least {size} ({note}; `variants CASE --minimal --dmax {size}` \
+                         decides them all)",
+                        plural(size - 1, "element"),
+                    ),
+                    json: json!({
+                        "searched_to": size,
+                        "smallest_linear": smallest_linear,
+                        "smallest_balanced": null,
+                        "at_least": size,
+                        "example": null,
+                        "decided": decided,
+                        "undecided": undecided,
+                        "note": note,
+                        "source": "variants --minimal",
+                    }),
+                };
+            }
+            Probe::None { undecided: u } => undecided += u,
         }
-        None => format!(
-            "no variant of at most {} balances (minimal-set walk to Dmax {probe}{})",
-            plural(probe, "element"),
-            report.smallest_linear.map_or(String::new(), |d| format!(
+        searched_to = size;
+    }
+    if searched_to == dmax {
+        return not_looked(
+            "a deeper search is past the limits (`variants CASE --minimal --dmax N`)",
+        );
+    }
+    Smallest {
+        sentence: format!(
+            "no variant of at most {} balances (minimal-set walk to Dmax {searched_to}{}{})",
+            plural(searched_to, "element"),
+            smallest_linear.map_or(String::new(), |d| format!(
                 "; the balance equations are solvable from {d} elements, not realizably"
-            ))
+            )),
+            if undecided > 0 {
+                format!("; {undecided} sets undecided")
+            } else {
+                String::new()
+            }
         ),
-    };
-    Smallest { sentence, json }
+        json: json!({
+            "searched_to": searched_to,
+            "smallest_linear": smallest_linear,
+            "smallest_balanced": null,
+            "example": null,
+            "decided": DECISION_BUDGET - left,
+            "undecided": undecided,
+            "note": null,
+            "source": "variants --minimal",
+        }),
+    }
 }
 
 /// The fallback of a study at `dmax` whose search found `found` and whose ranking has no
@@ -240,12 +388,80 @@ pub fn fallback(model: &Model, dmax: usize, found: &SearchReport) -> Result<Fall
     let csv = computed
         .as_ref()
         .map_or_else(|_| String::new(), |c| csv(model, c));
+    let section = section(model, first, &computed);
     Ok(Fallback {
         note,
         text,
         json,
         csv,
+        section,
     })
+}
+
+/// The reports' section: the statement and partial.json's designs as plain numbers.
+fn section(
+    model: &Model,
+    statement: String,
+    computed: &Result<Computed, String>,
+) -> PartialBalancing {
+    let actuators: Vec<String> = model.actuators.iter().map(|a| a.name.clone()).collect();
+    let mut section = PartialBalancing {
+        smallest_dmax: statement,
+        skipped: None,
+        budget: 0,
+        points: 0,
+        actuators: actuators.clone(),
+        minimised: Vec::new(),
+        unbalanced_rms: Vec::new(),
+        unbalanced_total: 0.0,
+        sets: 0,
+        designs: Vec::new(),
+    };
+    let c = match computed {
+        Ok(c) => c,
+        Err(reason) => {
+            section.skipped = Some(reason.clone());
+            return section;
+        }
+    };
+    let r = &c.report;
+    section.budget = r.budget;
+    section.points = r.points;
+    section.minimised = r.joints.iter().map(|&j| actuators[j].clone()).collect();
+    section.unbalanced_rms = r.unbalanced_rms.clone();
+    section.unbalanced_total = r.unbalanced_total;
+    section.sets = r.sets;
+    section.designs = r
+        .designs
+        .iter()
+        .enumerate()
+        .map(|(i, d)| PartialDesign {
+            rank: i + 1,
+            elements: d
+                .counterweights
+                .iter()
+                .map(|cw| {
+                    let label = super::model_label(d, cw.entry);
+                    PartialElement {
+                        unused: d.unused.contains(&label),
+                        label,
+                        body: model.bodies[cw.body].name.clone(),
+                        mass: cw.mass,
+                        offset: cw.offset,
+                    }
+                })
+                .collect(),
+            total_rms: d.total_rms,
+            rms: d.rms.clone(),
+            exact: c
+                .shown
+                .iter()
+                .zip(&c.verdicts)
+                .find(|(s, _)| **s == i)
+                .map(|(_, v)| v.name().to_string()),
+        })
+        .collect();
+    section
 }
 
 /// The heading and one line per shown design: set, total change, the change of each actuator
