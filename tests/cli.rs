@@ -347,6 +347,19 @@ fn check_names_the_path_of_the_balance_decision() {
     let text = stdout(&out);
     assert!(text.contains("balance decision: numeric"), "{text}");
     assert!(text.contains("bodies[0].pose[0].rot_y"), "{text}");
+    // A quarter turn plus π/6 (cos = −1/2, sin = √3/2), and atan2(√2, 1) (cos = 1/√3,
+    // sin = √2/√3): both have cosine and sine in ℚ(√2, √3), so the decision is exact there.
+    for turn in ["th1 + 2*pi/3", "th1 + atan2(2*sin(pi/4), 1)"] {
+        case["bodies"][0]["pose"][0]["rot_y"] = serde_json::json!(turn);
+        write_case(dir.path(), "turned.json", &case);
+        let out = counterpoise(&["check", path.to_str().unwrap()]);
+        assert!(out.status.success(), "{turn}: {}", stderr(&out));
+        let text = stdout(&out);
+        assert!(
+            text.contains("balance decision: exact over ℚ(√2, √3) (every rotation has its cosine"),
+            "{turn}: {text}"
+        );
+    }
 }
 
 #[test]

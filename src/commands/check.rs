@@ -224,7 +224,8 @@ pub fn summary(model: &Model) -> String {
             Ok(_) => "exact over ℚ (every number of the case is rational)".to_string(),
             Err(_) => {
                 match counterpoise_model::exact_mechanism_in::<counterpoise_symbolic::Surd>(model) {
-                    Ok(_) => "exact over ℚ(√2, √3) (rotations by multiples of π/12)".to_string(),
+                    Ok(_) => "exact over ℚ(√2, √3) (every rotation has its cosine and sine in that field: \
+                         multiples of π/12, or atan2 of field numbers such as atan2(√2, 1))".to_string(),
                     Err(e) => format!(
                         "numeric: {e} (floating point, with an ambiguous zone reported as undecided)"
                     ),

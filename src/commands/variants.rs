@@ -185,7 +185,8 @@ fn decision_line(report: &SearchReport) -> String {
         }
         Arithmetic::Surd if exact == report.variants.len() => {
             "decided in exact arithmetic over ℚ(√2, √3) (numbers q₀ + q₁√2 + q₂√3 + q₃√6 with \
-             rational qᵢ: the case rotates by multiples of π/12; see `check`)\n"
+             rational qᵢ: every rotation of the case has its cosine and sine in that field, as multiples \
+             of π/12 do; see `check`)\n"
                 .to_string()
         }
         _ => format!(
