@@ -42,6 +42,46 @@ fn arm6_variants_at_dmax_3_finish_without_a_panic() {
         .expect("m1 + K61 + K65 enumerated");
     assert_eq!(former["status"], "infeasible");
     assert_eq!(former["decision"], "exact");
+    // m5 + K30 (a counterweight on wrist_2, a spring from the forearm to the base): balance
+    // makes K30·az = 0, so a physical spring has az = 0 and K30·az·bz = 0, and the balance
+    // relation m5 − (10000/38259)·K30·az·bz = −823/195 kg then asks for m5 = −823/195 kg, the
+    // mass m2 + m5 asks for too (its own linear solve). Once undecided ("no physical
+    // parameters found"), now proved.
+    let m5_k30 = find(variants, &["m5", "K30"]);
+    assert_eq!(m5_k30["status"], "unrealizable", "{m5_k30}");
+    let reason = m5_k30["reason"].as_str().unwrap();
+    assert!(
+        reason.contains("a = (0, free, 0)") && reason.contains("-823/195"),
+        "{reason}"
+    );
+    let m2_m5 = find(variants, &["m2", "m5"]);
+    assert!(
+        m2_m5["reason"].as_str().unwrap().contains("-823/195"),
+        "{m2_m5}"
+    );
+    let undecided = variants
+        .iter()
+        .filter(|v| v["status"] == "undecided")
+        .count();
+    assert!(
+        undecided <= 8,
+        "{undecided} undecided (8 spring triples are left)"
+    );
+}
+
+fn find<'a>(variants: &'a [serde_json::Value], labels: &[&str]) -> &'a serde_json::Value {
+    variants
+        .iter()
+        .find(|v| {
+            let own: Vec<&str> = v["elements"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|e| e["label"].as_str().unwrap())
+                .collect();
+            own == labels
+        })
+        .unwrap_or_else(|| panic!("{labels:?} enumerated"))
 }
 
 /// `--minimal` at Dmax 6: the 54 minimal sets (27 pairs, 27 triples; the balance crate's test
@@ -116,7 +156,7 @@ fn the_minimal_guard_estimates_the_pruned_walk() {
     );
 }
 
-/// `run` on the arm at Dmax 2 (nothing balances: 25 unrealizable, 2 undecided, 351 infeasible)
+/// `run` on the arm at Dmax 2 (nothing balances: 27 unrealizable, 351 infeasible)
 /// states the smallest Dmax at which a variant balances — 3, as the full Dmax 3 search of
 /// `arm6_variants_at_dmax_3_finish_without_a_panic` and the minimal sets above find — and
 /// writes the partial balancing with at most 2 counterweights: C(6, 1) + C(6, 2) = 21 sets,

@@ -515,7 +515,8 @@ where
 
 /// For every spring whose anchor `a` (or `b`) balance fixes — `K·a = a₀·K` on the whole family —
 /// the equations `W = a₀ βᵀ` (or `W = α b₀ᵀ`) a physical spring must satisfy, as rows over the
-/// variant's variables; and the anchors, described.
+/// variant's variables; for a spring whose anchors balance fixes only in some components, the
+/// rows and columns of `W` those components determine; and the anchors, described.
 #[allow(clippy::type_complexity)]
 fn fixed_anchor_equations<F: ExactField>(
     solution: &ExactSolution<F>,
@@ -550,12 +551,55 @@ where
                 }
             }
         };
-        if let Some(a0) = solution.proportional_to(start, alpha..alpha + na) {
+        let a_parts = solution.proportional_components(start, alpha..alpha + na);
+        let b_parts = solution.proportional_components(start, beta..beta + nb);
+        if let Some(a0) = a_parts.iter().cloned().collect::<Option<Vec<F>>>() {
             push_rows(&a0, beta, true);
             anchors.push(describe("a", &a0));
-        } else if let Some(b0) = solution.proportional_to(start, beta..beta + nb) {
+        } else if let Some(b0) = b_parts.iter().cloned().collect::<Option<Vec<F>>>() {
             push_rows(&b0, alpha, false);
             anchors.push(describe("b", &b0));
+        } else {
+            // Neither anchor is fixed whole, but some of their components may be: `a_i = a₀ᵢ`
+            // gives `W_ij = a₀ᵢ·β_j` for every j (row i of W), `b_j = b₀ⱼ` gives
+            // `W_ij = b₀ⱼ·α_i` for every i (column j). In particular `K·a_i = 0` on the family
+            // means `a_i = 0` (K > 0), so the whole row `W_i·` of a physical spring is zero.
+            for (i, ai) in a_parts.iter().enumerate() {
+                let Some(ai) = ai else { continue };
+                for j in 0..nb {
+                    let mut row = vec![F::zero(); n];
+                    row[w + i * nb + j] = F::one();
+                    row[beta + j] = -ai.clone();
+                    rows.push(row);
+                }
+            }
+            for (j, bj) in b_parts.iter().enumerate() {
+                let Some(bj) = bj else { continue };
+                for i in 0..na {
+                    let mut row = vec![F::zero(); n];
+                    row[w + i * nb + j] = F::one();
+                    row[alpha + i] = -bj.clone();
+                    rows.push(row);
+                }
+            }
+            let part = |side: &str, parts: &[Option<F>]| {
+                let values: Vec<String> = parts
+                    .iter()
+                    .map(|v| {
+                        v.as_ref()
+                            .map_or("free".to_string(), crate::exact::exact_text)
+                    })
+                    .collect();
+                format!("{side} = ({})", values.join(", "))
+            };
+            if a_parts.iter().chain(&b_parts).any(Option::is_some) {
+                anchors.push(format!(
+                    "{}'s anchor components {} and {}",
+                    entry.label,
+                    part("a", &a_parts),
+                    part("b", &b_parts)
+                ));
+            }
         }
     }
     (anchors, rows)
@@ -817,6 +861,63 @@ mod tests {
         let (anchors, rows) = fixed_anchor_equations(&basis.solve(&[0]), &[(0, &entry)]);
         assert_eq!(anchors, vec!["K1's anchor b = (3)".to_string()]);
         assert_eq!(rows, vec![vec![q(0), q(-3), q(0), q(1)]]);
+    }
+
+    /// A spring's variables `(K, αx, αy, βx, βy, Wxx, Wxy, Wyx, Wyy)` with the hand-written
+    /// balance equations `αx = 0` and `K + Wxx = 0`: the lifted family has positive stiffnesses
+    /// (`K = −Wxx` for any `Wxx < 0`) and neither anchor is fixed whole, but `K·ax = 0` with
+    /// `K > 0` means `ax = 0`, so a physical spring has the row `Wx· = ax·β = 0`: `Wxx = 0`,
+    /// `Wxy = 0`. Then `K = −Wxx = 0`: no spring balances it (the proof the arm6 set m5 + K30
+    /// needs, where `K30·az = 0` and the mass of m5 hangs on `K30·az·bz`).
+    #[test]
+    fn a_zero_anchor_component_zeroes_its_row_of_w() {
+        use crate::exact::ExactBasis;
+        use counterpoise_symbolic::{Monomial, Rational};
+        let int = |v: &[i64]| -> Vec<num_bigint::BigInt> { v.iter().map(|&x| x.into()).collect() };
+        let q = |n: i64| Rational::from_integer(n.into());
+        let mut columns = vec![int(&[0, 0]); 9];
+        columns[1] = int(&[1, 0]);
+        columns[0] = int(&[0, 1]);
+        columns[5] = int(&[0, 1]);
+        let basis = ExactBasis {
+            monomials: vec![Monomial::sine(0), Monomial::sine(1)],
+            unbalanced: int(&[0, 0]),
+            elements: vec![columns],
+            row_factors: vec![q(1), q(1)],
+        };
+        let solution = basis.solve(&[0]);
+        let entry = CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0, 1],
+                axes_b: vec![0, 1],
+            },
+            label: "K1".into(),
+            description: "a spring".into(),
+            variables: Vec::new(),
+            energy: Vec::new(),
+        };
+        let entries = [(0, &entry)];
+        // The family alone proves nothing: K = −Wxx is positive where Wxx < 0.
+        assert!(exact_sign_proof(&solution, &entries).is_none());
+        let (anchors, rows) = fixed_anchor_equations(&solution, &entries);
+        assert_eq!(
+            anchors,
+            vec!["K1's anchor components a = (0, free) and b = (free, free)".to_string()]
+        );
+        let unit = |j: usize| {
+            let mut r = vec![q(0); 9];
+            r[j] = q(1);
+            r
+        };
+        // Row x of W: Wxx − 0·βx and Wxy − 0·βy.
+        assert_eq!(rows, vec![unit(5), unit(6)]);
+        let restricted = basis.solve_with(&[0], &rows);
+        assert!(restricted.consistent());
+        let proof =
+            exact_sign_proof(&restricted, &entries).expect("K = 0 on the restricted family");
+        assert!(proof.contains("K1"), "{proof}");
     }
 
     /// A spring whose balance equations fix `α = (2, 1)`, `β = (3, 2)`, `Wxx = Wyy = 1` and leave

@@ -243,6 +243,19 @@ where
         stiffness: usize,
         range: std::ops::Range<usize>,
     ) -> Option<Vec<F>> {
+        self.proportional_components(stiffness, range)
+            .into_iter()
+            .collect()
+    }
+
+    /// For each variable of `range`, `Some(v)` when it equals `v·K(z)` on the whole family for
+    /// a constant `v`: that component of the spring's anchor is fixed by balance (zero when
+    /// the lifted variable `K·a_i` vanishes on the family), whatever the others do.
+    pub fn proportional_components(
+        &self,
+        stiffness: usize,
+        range: std::ops::Range<usize>,
+    ) -> Vec<Option<F>> {
         let k = self.affine(stiffness);
         let pivot = k.coefficients.iter().position(|c| !c.is_zero());
         range
