@@ -17,6 +17,7 @@
 //! the projection of the positive family. Springs whose balance zeroes a block of `K·a·bᵀ` are
 //! split on which anchor part vanishes ([`split`]).
 
+pub mod anchors;
 pub mod elimination;
 pub mod elimination_field;
 pub mod field;

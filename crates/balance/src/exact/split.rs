@@ -8,10 +8,16 @@
 //! decided exactly like the variant itself: inconsistent, a sign proof, a rank-one contradiction,
 //! or a further split. When every branch is refuted the variant is proved unrealizable; a branch
 //! left open is a smaller linear family where the witness search can look.
+//!
+//! The same holds for any linear identity of one anchor row: when balance makes
+//! `c·α_i + Σ_j d_j·W_ij = 0` on the whole family, a physical spring has
+//! `a_i·(c·K + d·β) = 0` (`α_i = a_i K`, `W_ij = a_i β_j`), so `a_i = 0` (with `W_i· = 0`) or
+//! `c·K + d·β = 0`; and for a column of `b`, `b_j·(c·K + d·α) = 0`. A zero block is the case
+//! `c = 0`, `d` a unit vector ([`Factor`] splits the others).
 
 use counterpoise_symbolic::RefArith;
 
-use super::{ExactBasis, ExactField, ExactSolution, rank_one};
+use super::{ExactBasis, ExactField, ExactSolution, anchors, rank_one};
 use crate::element::{CatalogueEntry, Element};
 
 /// At most this many families are solved for one variant (the splits branch twice each).
@@ -84,6 +90,145 @@ where
     out
 }
 
+/// A linear identity of one anchor row (or column) on the family that is not a zero block:
+/// `c·α_i + d·W_i· = 0` (`side_a`), or `c·β_j + d·W_·j = 0`, with `coefficients = (c, d)`.
+struct Factor<F> {
+    k: usize,
+    side_a: bool,
+    index: usize,
+    coefficients: Vec<F>,
+}
+
+/// The identities of each spring's anchor rows and columns on the family: the null space of
+/// the values `(α_i, W_i·)` (or `(β_j, W_·j)`) take over the family, in reduced echelon form;
+/// those that only say some `W_ij = 0` are left to [`rectangles`], and a row whose `α_i` is
+/// already zero has nothing to split.
+fn factors<F: ExactField>(
+    solution: &ExactSolution<F>,
+    entries: &[(usize, &CatalogueEntry)],
+) -> Vec<Factor<F>>
+where
+    for<'a> &'a F: RefArith<F>,
+{
+    let zero = |j: usize| solution.is_fixed(j) && solution.particular[j].is_zero();
+    let mut out = Vec::new();
+    for (k, (_, entry)) in entries.iter().enumerate() {
+        let Element::Spring { axes_a, axes_b, .. } = &entry.element else {
+            continue;
+        };
+        let (na, nb) = (axes_a.len(), axes_b.len());
+        let start = solution.offsets[k];
+        let w = |i: usize, j: usize| start + 1 + na + nb + i * nb + j;
+        for side_a in [true, false] {
+            let (count, other) = if side_a { (na, nb) } else { (nb, na) };
+            for index in 0..count {
+                let head = start + 1 + if side_a { index } else { na + index };
+                if zero(head) {
+                    continue;
+                }
+                let mut variables = vec![head];
+                variables.extend((0..other).map(
+                    |t| {
+                        if side_a { w(index, t) } else { w(t, index) }
+                    },
+                ));
+                for coefficients in identities(solution, &variables) {
+                    let only_w_unit = coefficients[0].is_zero()
+                        && coefficients[1..].iter().filter(|c| !c.is_zero()).count() == 1;
+                    if !only_w_unit {
+                        out.push(Factor {
+                            k,
+                            side_a,
+                            index,
+                            coefficients,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The vectors `c` with `Σ c_t·x_{variables[t]} = 0` on the whole family: the null space of
+/// the matrix whose rows are the variables' constant part and their free directions.
+fn identities<F: ExactField>(solution: &ExactSolution<F>, variables: &[usize]) -> Vec<Vec<F>>
+where
+    for<'a> &'a F: RefArith<F>,
+{
+    let mut rows: Vec<Vec<F::Entry>> = std::iter::once(&solution.particular)
+        .chain(&solution.nullspace)
+        .map(|v| {
+            let values: Vec<F> = variables.iter().map(|&j| v[j].clone()).collect();
+            let mut row = F::equation_row(&values);
+            row.push(F::zero_entry());
+            row
+        })
+        .collect();
+    rows.retain(|r| r.iter().any(|e| !F::entry_is_zero(e)));
+    F::eliminate(rows, variables.len()).nullspace()
+}
+
+/// The two branches of a [`Factor`]: the anchor part zero (`α_i = 0`, `W_i· = 0`), or the
+/// other factor `c·K + d·β = 0` (`c·K + d·α = 0` for a column).
+fn factor_rows<F: ExactField>(
+    solution: &ExactSolution<F>,
+    entries: &[(usize, &CatalogueEntry)],
+    f: &Factor<F>,
+    part_zero: bool,
+) -> Vec<Vec<F>> {
+    if part_zero {
+        let r = Rectangle {
+            k: f.k,
+            rows: if f.side_a { vec![f.index] } else { Vec::new() },
+            columns: if f.side_a { Vec::new() } else { vec![f.index] },
+        };
+        return branch_rows(solution, entries, &r, f.side_a);
+    }
+    let Element::Spring { axes_a, axes_b, .. } = &entries[f.k].1.element else {
+        unreachable!("factors are found on springs only");
+    };
+    let (na, nb) = (axes_a.len(), axes_b.len());
+    let start = solution.offsets[f.k];
+    let mut row = vec![F::zero(); solution.echelon.columns];
+    row[start] = f.coefficients[0].clone();
+    // d·β for a row of a, d·α for a column of b.
+    let first = if f.side_a { start + 1 + na } else { start + 1 };
+    let count = if f.side_a { nb } else { na };
+    row[first..first + count].clone_from_slice(&f.coefficients[1..]);
+    vec![row]
+}
+
+/// `c·K + d·β` (or `d·α`) of a [`Factor`] in the spring's variable names, for proofs.
+fn factor_text<F: ExactField>(entry: &CatalogueEntry, f: &Factor<F>) -> (String, String)
+where
+    for<'a> &'a F: RefArith<F>,
+{
+    let Element::Spring { axes_a, axes_b, .. } = &entry.element else {
+        unreachable!("factors are found on springs only");
+    };
+    let axis = |axes: &[usize], t: usize| ["x", "y", "z"][axes[t]];
+    let (part, others, other_side) = if f.side_a {
+        (format!("a{}", axis(axes_a, f.index)), axes_b, "b")
+    } else {
+        (format!("b{}", axis(axes_b, f.index)), axes_a, "a")
+    };
+    let mut terms = Vec::new();
+    let mut push = |c: &F, name: String| {
+        if !c.is_zero() {
+            terms.push(format!("{}·{name}", super::exact_text(c)));
+        }
+    };
+    push(&f.coefficients[0], "K".to_string());
+    for t in 0..others.len() {
+        push(
+            &f.coefficients[1 + t],
+            format!("K·{other_side}{}", axis(others, t)),
+        );
+    }
+    (part, terms.join(" + "))
+}
+
 /// Equations `α_I = 0` and `W_I· = 0` (`side_a`), or `β_J = 0` and `W_·J = 0`.
 fn branch_rows<F: ExactField>(
     solution: &ExactSolution<F>,
@@ -151,10 +296,35 @@ where
         return open();
     }
     *budget -= 1;
-    let solution = basis.solve_with(set, extra);
+    let mut solution = basis.solve_with(set, extra);
     if !solution.consistent() {
         return Outcome::Proof("the balance equations have no solution".to_string());
     }
+    // A branch can fix anchor components the family left free (a_i = 0 once α_i = 0): impose
+    // what that means for W, until nothing new follows (the rank only grows, so this ends).
+    let mut extra = extra.to_vec();
+    loop {
+        let (_, rows) = anchors::fixed_anchor_equations(&solution, entries);
+        if rows.is_empty() {
+            break;
+        }
+        let mut more = extra.clone();
+        more.extend(rows);
+        let restricted = basis.solve_with(set, &more);
+        if !restricted.consistent() {
+            return Outcome::Proof(
+                "with the anchor components balance then fixes, the balance equations have no \
+                 solution"
+                    .to_string(),
+            );
+        }
+        if restricted.rank() == solution.rank() {
+            break;
+        }
+        (extra, solution) = (more, restricted);
+    }
+    let extra = &extra[..];
+    let open = || Outcome::Open(vec![extra.to_vec()]);
     let refs: Vec<&CatalogueEntry> = entries.iter().map(|(_, e)| *e).collect();
     if let Some(reason) =
         sign_proof(&solution).or_else(|| rank_one::contradiction(basis, &solution, &refs))
@@ -186,6 +356,32 @@ where
                  anchor a has no {ai} part or b no {bj} part; with a's {ai} zero, {p}; with b's \
                  {bj} zero, {q}",
                 label = entries[r.k].1.label,
+                p = proofs[0],
+                q = proofs[1],
+            ));
+        }
+        if leaves.is_empty() {
+            leaves = open_here;
+        }
+    }
+    for f in factors(&solution, entries) {
+        let mut proofs = Vec::new();
+        let mut open_here = Vec::new();
+        for part_zero in [true, false] {
+            let mut rows = extra.to_vec();
+            rows.extend(factor_rows(&solution, entries, &f, part_zero));
+            match node(basis, set, entries, &rows, depth - 1, sign_proof, budget) {
+                Outcome::Proof(p) => proofs.push(p),
+                Outcome::Open(l) => open_here.extend(l),
+            }
+        }
+        if proofs.len() == 2 {
+            let entry = entries[f.k].1;
+            let (part, other) = factor_text(entry, &f);
+            return Outcome::Proof(format!(
+                "{label}: balance makes {part}·({other}) = 0, so {part} = 0 or \
+                 {other} = 0; with {part} = 0, {p}; with {other} = 0, {q}",
+                label = entry.label,
                 p = proofs[0],
                 q = proofs[1],
             ));
@@ -311,5 +507,50 @@ mod tests {
         assert!(rectangles_of(&[(0, 1), (6, 0), (4, 0)]).is_empty());
         // Wxx = 1: nothing is zero.
         assert!(rectangles_of(&[(0, 1), (5, 1)]).is_empty());
+    }
+    /// The one spring with the single hand-written balance row `αy + 2·Wyy = 0` (every other
+    /// variable free). For a physical spring `αy = ay·K` and `Wyy = ay·βy`, so the row says
+    /// `ay·(K + 2·βy) = 0`: the one identity of an anchor row or column (no `W` component is
+    /// zero, no other row or column is constrained), with the branches `αy = 0, Wyx = Wyy = 0`
+    /// and `K + 2·βy = 0`.
+    #[test]
+    fn a_row_identity_splits_into_a_zero_part_or_the_other_factor() {
+        let mut columns = vec![vec![BigInt::from(0)]; 9];
+        columns[2] = vec![BigInt::from(1)];
+        columns[8] = vec![BigInt::from(2)];
+        let basis = ExactBasis {
+            monomials: vec![Monomial::sine(0)],
+            unbalanced: vec![BigInt::from(0)],
+            elements: vec![columns],
+            row_factors: vec![Rational::from_integer(1.into())],
+        };
+        let solution = basis.solve(&[0]);
+        let entry = spring();
+        let entries = [(0, &entry)];
+        assert!(rectangles(&solution, &entries).is_empty());
+        let found = factors(&solution, &entries);
+        assert_eq!(found.len(), 1);
+        let f = &found[0];
+        assert!(f.side_a && f.index == 1, "row y of a");
+        let q = |n: i64| Rational::from_integer(n.into());
+        // (c, d_x, d_y) ∝ (1, 0, 2).
+        let c = f.coefficients[0].clone();
+        assert_ne!(c, q(0));
+        let scaled: Vec<Rational> = f.coefficients.iter().map(|v| v / &c).collect();
+        assert_eq!(scaled, vec![q(1), q(0), q(2)]);
+        assert_eq!(
+            zeroed(&factor_rows(&solution, &entries, f, true)),
+            vec![2, 7, 8]
+        );
+        let other = factor_rows(&solution, &entries, f, false);
+        assert_eq!(other.len(), 1);
+        let row: Vec<Rational> = other[0].iter().map(|v| v / &c).collect();
+        let mut expected = vec![q(0); 9];
+        expected[0] = q(1);
+        expected[4] = q(2);
+        assert_eq!(row, expected, "K + 2·βy = 0");
+        let (part, text) = factor_text(&entry, f);
+        assert_eq!(part, "ay");
+        assert!(text.contains("·K") && text.contains("·K·by"), "{text}");
     }
 }
