@@ -367,8 +367,14 @@ fn decide_exact<F: ExactField>(
     }
     result.ranges = admissible_ranges(&solution, entries, &names, &units);
     // A verified witness settles it; the remaining proofs run only when none is found.
+    let mut failed = None;
     let witness = match find_witness(&linear, &numeric.unbalanced, entries, hints) {
-        Ok(witness) => return accept_witness(checks, witness, result),
+        Ok(witness) => {
+            if try_witness(checks, witness, result, &mut failed) {
+                return;
+            }
+            "the witness found failed verification".to_string()
+        }
         Err(reason) => reason,
     };
     if !screened && let Some(reason) = rank_one::contradiction(exact, &solution, &refs) {
@@ -396,8 +402,10 @@ fn decide_exact<F: ExactField>(
             return;
         }
         let linear = crate::linear::from_exact(numeric, &restricted);
-        if let Ok(witness) = find_witness(&linear, &numeric.unbalanced, entries, hints) {
-            return accept_witness(checks, witness, result);
+        if let Ok(witness) = find_witness(&linear, &numeric.unbalanced, entries, hints)
+            && try_witness(checks, witness, result, &mut failed)
+        {
+            return;
         }
     }
     // Springs whose balance zeroes a block of W: split on which anchor part vanishes.
@@ -424,8 +432,10 @@ fn decide_exact<F: ExactField>(
                     let zero = unit_columns(rows);
                     let found =
                         find_witness_on(&linear, &numeric.unbalanced, entries, hints, &zero);
-                    if let Ok(w) = found {
-                        return accept_witness(checks, w, result);
+                    if let Ok(w) = found
+                        && try_witness(checks, w, result, &mut failed)
+                    {
+                        return;
                     }
                 }
             }
@@ -438,8 +448,12 @@ fn decide_exact<F: ExactField>(
         && svd.consistent
         && svd.rank == solution.rank()
         && let Ok(w) = find_witness(&svd, &numeric.unbalanced, entries, hints)
+        && try_witness(checks, w, result, &mut failed)
     {
-        return accept_witness(checks, w, result);
+        return;
+    }
+    if let Some((w, verification)) = failed {
+        return record_witness(w, verification, result);
     }
     result.status = Status::Undecided;
     result.reason = Some(witness);
@@ -518,6 +532,11 @@ where
 /// element can only idle) if it passes, undecided if not.
 fn accept_witness(checks: &VerificationSet, witness: Witness, result: &mut VariantResult) {
     let verification = checks.verify(&witness);
+    record_witness(witness, verification, result);
+}
+
+/// The verdict a verified (or failed) witness gives.
+fn record_witness(witness: Witness, verification: Verification, result: &mut VariantResult) {
     if verification.passed {
         if result.idle.is_empty() {
             result.status = Status::Balanced;
@@ -543,6 +562,25 @@ fn accept_witness(checks: &VerificationSet, witness: Witness, result: &mut Varia
     }
     result.witness = Some(witness);
     result.verification = Some(verification);
+}
+
+/// Accepts `witness` when it passes verification (`true`). A witness that fails is kept in
+/// `failed` (the first one) and the search goes on: another route may find one that passes,
+/// or a proof; only if neither turns up is the failed one the variant's (undecided) answer.
+fn try_witness(
+    checks: &VerificationSet,
+    witness: Witness,
+    result: &mut VariantResult,
+    failed: &mut Option<(Witness, Verification)>,
+) -> bool {
+    let verification = checks.verify(&witness);
+    if verification.passed {
+        record_witness(witness, verification, result);
+        true
+    } else {
+        failed.get_or_insert((witness, verification));
+        false
+    }
 }
 
 /// The numeric path, for cases with irrational constants: floating-point consistency and
