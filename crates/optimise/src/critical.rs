@@ -13,7 +13,7 @@
 //! point, so the relaxation's bound on the final working set bounds the true optimum.
 
 use counterpoise_dynamics::linalg::checked_svd;
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 use counterpoise_balance::linear::solve;
 use counterpoise_balance::{Attachment, Status, VariantResult};
@@ -890,51 +890,151 @@ fn reaction_peaks(ctx: &Context, variants: &[Variant], tasks: &[usize]) -> Optio
     let ev = Evaluator::new(&ctx.model).ok()?;
     let params = ParameterSet::from_variants(&ctx.model, variants).ok()?;
     let columns: Vec<usize> = (0..params.len()).collect();
-    let nj = ctx.model.joints.len();
     let per_task: Vec<Option<Vec<JointPeaks>>> = tasks
         .par_iter()
         .map_init(Workspace::default, |ws, &w| {
-            let (i, j) = ctx.tasks.pair(w);
-            let mut q = ev.solve_point(&ctx.tasks.points[i]).ok()?;
-            let mut acc = vec![(vec![0.0; nj], vec![0.0; nj]); columns.len()];
-            ev.run_move(
-                &ctx.tasks.points[i],
-                &ctx.tasks.points[j],
-                ctx.tasks.duration,
-                ctx.tasks.samples,
-                &mut q,
-                &params,
-                &columns,
-                true,
-                ws,
-                |_, view| {
-                    for (c, a) in acc.iter_mut().enumerate() {
-                        let r = &view.reactions[c];
-                        for (p, f) in a.0.iter_mut().zip(r.force_magnitudes()) {
-                            *p = f64::max(*p, f);
-                        }
-                        for (p, m) in a.1.iter_mut().zip(r.moment_magnitudes()) {
-                            *p = f64::max(*p, m);
-                        }
-                    }
-                },
-            )
-            .ok()?;
-            Some(acc)
+            move_peaks(ctx, &ev, &params, w, &columns, ws)
         })
         .collect();
-    let mut total = vec![(vec![0.0; nj], vec![0.0; nj]); columns.len()];
+    let mut total = zero_peaks(ctx, columns.len());
     for t in per_task.into_iter().flatten() {
-        for (tot, a) in total.iter_mut().zip(t) {
-            for (x, y) in tot.0.iter_mut().zip(a.0) {
-                *x = f64::max(*x, y);
+        raise_peaks(&mut total, t);
+    }
+    Some(total)
+}
+
+/// [`reaction_peaks`] of several groups of variants (each with its own tasks) in one pass
+/// over the union of their tasks: a task's kinematics and reaction factorisation, per sample,
+/// are computed once for every group that needs the task (the spring options of all runs
+/// share the unbalanced joints' critical tasks), not once per group.
+///
+/// The result is the same bits as [`reaction_peaks`] group by group: a column's reactions are
+/// the same arithmetic whatever other columns share the sample (one Cholesky factor, the
+/// substitutions lane by lane; spring slots a column does not use are skipped; its own slots
+/// keep their order), and each group takes the maximum over its own tasks only. A task that
+/// fails for the batch is run again group by group, so that a non-finite value of one group
+/// leaves the task out for that group alone, as on its own.
+fn batched_reaction_peaks(
+    ctx: &Context,
+    groups: &[(&[Variant], &[usize])],
+) -> Vec<Option<Vec<JointPeaks>>> {
+    let all: Vec<Variant> = groups.iter().flat_map(|g| g.0.iter().cloned()).collect();
+    let (Ok(ev), Ok(params)) = (
+        Evaluator::new(&ctx.model),
+        ParameterSet::from_variants(&ctx.model, &all),
+    ) else {
+        return groups
+            .iter()
+            .map(|(variants, tasks)| reaction_peaks(ctx, variants, tasks))
+            .collect();
+    };
+    let mut first = Vec::with_capacity(groups.len());
+    let mut next = 0;
+    for (variants, _) in groups {
+        first.push(next);
+        next += variants.len();
+    }
+    let columns_of = |gs: &[usize]| -> Vec<usize> {
+        gs.iter()
+            .flat_map(|&g| first[g]..first[g] + groups[g].0.len())
+            .collect()
+    };
+    let mut needed: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (g, (_, tasks)) in groups.iter().enumerate() {
+        for &w in *tasks {
+            needed.entry(w).or_default().push(g);
+        }
+    }
+    let needed: Vec<(usize, Vec<usize>)> = needed.into_iter().collect();
+    // Per task, per group needing it: the group's peaks on that task (`None`: left out).
+    let per_task: Vec<Vec<Option<Vec<JointPeaks>>>> = needed
+        .par_iter()
+        .map_init(Workspace::default, |ws, (w, gs)| {
+            match move_peaks(ctx, &ev, &params, *w, &columns_of(gs), ws) {
+                Some(mut peaks) => gs
+                    .iter()
+                    .rev()
+                    .map(|&g| Some(peaks.split_off(peaks.len() - groups[g].0.len())))
+                    .collect::<Vec<_>>()
+                    .into_iter()
+                    .rev()
+                    .collect(),
+                None if gs.len() == 1 => vec![None],
+                None => gs
+                    .iter()
+                    .map(|&g| move_peaks(ctx, &ev, &params, *w, &columns_of(&[g]), ws))
+                    .collect(),
             }
-            for (x, y) in tot.1.iter_mut().zip(a.1) {
-                *x = f64::max(*x, y);
+        })
+        .collect();
+    let mut total: Vec<Vec<JointPeaks>> = groups
+        .iter()
+        .map(|(variants, _)| zero_peaks(ctx, variants.len()))
+        .collect();
+    for ((_, gs), peaks) in needed.iter().zip(per_task) {
+        for (&g, p) in gs.iter().zip(peaks) {
+            if let Some(p) = p {
+                raise_peaks(&mut total[g], p);
             }
         }
     }
-    Some(total)
+    total.into_iter().map(Some).collect()
+}
+
+/// Zero peaks for `columns` columns.
+fn zero_peaks(ctx: &Context, columns: usize) -> Vec<JointPeaks> {
+    let nj = ctx.model.joints.len();
+    vec![(vec![0.0; nj], vec![0.0; nj]); columns]
+}
+
+/// `total = max(total, peaks)`, entry by entry.
+fn raise_peaks(total: &mut [JointPeaks], peaks: Vec<JointPeaks>) {
+    for (tot, a) in total.iter_mut().zip(peaks) {
+        for (x, y) in tot.0.iter_mut().zip(a.0) {
+            *x = f64::max(*x, y);
+        }
+        for (x, y) in tot.1.iter_mut().zip(a.1) {
+            *x = f64::max(*x, y);
+        }
+    }
+}
+
+/// Peak joint reactions of `columns` of `params` over task `w` (`None` when the move fails).
+fn move_peaks(
+    ctx: &Context,
+    ev: &Evaluator,
+    params: &ParameterSet,
+    w: usize,
+    columns: &[usize],
+    ws: &mut Workspace,
+) -> Option<Vec<JointPeaks>> {
+    let (i, j) = ctx.tasks.pair(w);
+    let mut q = ev.solve_point(&ctx.tasks.points[i]).ok()?;
+    let mut acc = zero_peaks(ctx, columns.len());
+    ev.run_move(
+        &ctx.tasks.points[i],
+        &ctx.tasks.points[j],
+        ctx.tasks.duration,
+        ctx.tasks.samples,
+        &mut q,
+        params,
+        columns,
+        true,
+        ws,
+        |_, view| {
+            for (c, a) in acc.iter_mut().enumerate() {
+                let r = &view.reactions[c];
+                for (p, f) in a.0.iter_mut().zip(r.force_magnitudes()) {
+                    *p = f64::max(*p, f);
+                }
+                for (p, m) in a.1.iter_mut().zip(r.moment_magnitudes()) {
+                    *p = f64::max(*p, m);
+                }
+            }
+        },
+    )
+    .ok()?;
+    Some(acc)
 }
 
 /// ΔR (paper Eqs. 17–21, percent) of a variant whose peak joint reactions are `force`, `moment`
@@ -1092,14 +1192,7 @@ fn finish(
         joint_tasks.extend(ctx.task_index(j.moment_task));
     }
     let counter = StageCounter::start(progress, "spring choice", 0, runs.len());
-    let choices: Vec<Option<SpringChoice>> = runs
-        .par_iter()
-        .map(|run| {
-            let choice = spring_choice(ctx, run, &joint_tasks, options);
-            counter.tick();
-            choice
-        })
-        .collect();
+    let choices = spring_choices(ctx, &runs, &joint_tasks, options, &|| counter.tick());
     for (run, choice) in runs.iter_mut().zip(&choices) {
         if let (Some(c), Some((s, x, _))) = (run.candidate.as_mut(), choice) {
             c.springs = s.clone();
@@ -1144,21 +1237,54 @@ fn finish(
 
 /// The spring option of one run with the lowest ΔR on the reaction tasks (`None` for a run
 /// without a candidate).
+#[cfg(test)]
 fn spring_choice(
     ctx: &Context,
     run: &Run,
     joint_tasks: &BTreeSet<usize>,
     options: &OptimiseOptions,
 ) -> Option<SpringChoice> {
-    let cand = run.candidate.as_ref()?;
+    spring_choices(ctx, std::slice::from_ref(run), joint_tasks, options, &|| ())
+        .pop()
+        .flatten()
+}
+
+/// What the spring choice of one run needs.
+enum SpringOptions {
+    /// No candidate, or a run that did not converge or stop: no choice.
+    Nothing,
+    /// A candidate without springs: nothing to choose.
+    NoSprings(DVector<f64>),
+    /// The realizations found, their dynamics variants and the tasks they are scored on.
+    Options {
+        found: Vec<crate::springs::Realized>,
+        variants: Vec<Variant>,
+        tasks: Vec<usize>,
+    },
+}
+
+/// The spring options of one run (the admissible spring sets from four times the pass's
+/// starts; the candidate's own springs when none is found), scored on the reaction tasks plus
+/// the run's working set.
+fn spring_options(
+    ctx: &Context,
+    run: &Run,
+    joint_tasks: &BTreeSet<usize>,
+    options: &OptimiseOptions,
+) -> SpringOptions {
+    let Some(cand) = run.candidate.as_ref() else {
+        return SpringOptions::Nothing;
+    };
     if !matches!(run.state, State::Converged | State::Stopped) {
-        return None;
+        return SpringOptions::Nothing;
     }
-    let problem = run.problem.as_ref()?;
+    let Some(problem) = run.problem.as_ref() else {
+        return SpringOptions::Nothing;
+    };
     if problem.springs.is_empty() {
-        return Some((Vec::new(), cand.x.clone(), None));
+        return SpringOptions::NoSprings(cand.x.clone());
     }
-    let (found, _, _) = realize_springs_reusing(
+    let (mut found, _, _) = realize_springs_reusing(
         problem,
         &ctx.basis.unbalanced,
         &cand.x,
@@ -1166,11 +1292,10 @@ fn spring_choice(
         false,
         cand.spring_starts.as_ref(),
     );
-    let mut options_found: Vec<crate::springs::Realized> = found;
-    if options_found.is_empty() {
-        options_found.push((cand.springs.clone(), cand.x.clone()));
+    if found.is_empty() {
+        found.push((cand.springs.clone(), cand.x.clone()));
     }
-    let variants: Vec<Variant> = options_found
+    let variants: Vec<Variant> = found
         .iter()
         .map(|(s, _)| dynamics_variant(problem, &cand.cws, s))
         .collect();
@@ -1181,17 +1306,70 @@ fn spring_choice(
         .collect::<BTreeSet<_>>()
         .into_iter()
         .collect();
-    let peaks = reaction_peaks(ctx, &variants, &tasks);
-    let scores: Vec<Option<f64>> = match &peaks {
-        Some(p) => p
-            .iter()
-            .map(|(f, m)| delta_r(&ctx.unbalanced, f, m))
-            .collect(),
-        None => vec![None; variants.len()],
-    };
-    let best = lowest_delta_r(&scores).unwrap_or(0);
-    let (s, x) = options_found.swap_remove(best);
-    Some((s, x, scores[best]))
+    SpringOptions::Options {
+        found,
+        variants,
+        tasks,
+    }
+}
+
+/// The spring choice of every run, in run order: per run the option with the lowest ΔR on its
+/// reaction tasks (see [`lowest_delta_r`]). The options are realized run by run in parallel;
+/// their reactions are then evaluated in one batch over all the runs' tasks
+/// ([`batched_reaction_peaks`], the same bits as run by run). `tick` is called once per run as
+/// its choice is known.
+fn spring_choices(
+    ctx: &Context,
+    runs: &[Run],
+    joint_tasks: &BTreeSet<usize>,
+    options: &OptimiseOptions,
+    tick: &(dyn Fn() + Sync),
+) -> Vec<Option<SpringChoice>> {
+    let prepared: Vec<SpringOptions> = runs
+        .par_iter()
+        .map(|run| {
+            let o = spring_options(ctx, run, joint_tasks, options);
+            if !matches!(o, SpringOptions::Options { .. }) {
+                tick();
+            }
+            o
+        })
+        .collect();
+    let groups: Vec<(&[Variant], &[usize])> = prepared
+        .iter()
+        .filter_map(|o| match o {
+            SpringOptions::Options {
+                variants, tasks, ..
+            } => Some((&variants[..], &tasks[..])),
+            _ => None,
+        })
+        .collect();
+    let mut peaks = batched_reaction_peaks(ctx, &groups).into_iter();
+    prepared
+        .into_iter()
+        .map(|o| match o {
+            SpringOptions::Nothing => None,
+            SpringOptions::NoSprings(x) => Some((Vec::new(), x, None)),
+            SpringOptions::Options {
+                mut found,
+                variants,
+                ..
+            } => {
+                let peaks = peaks.next().expect("one result per group");
+                let scores: Vec<Option<f64>> = match &peaks {
+                    Some(p) => p
+                        .iter()
+                        .map(|(f, m)| delta_r(&ctx.unbalanced, f, m))
+                        .collect(),
+                    None => vec![None; variants.len()],
+                };
+                let best = lowest_delta_r(&scores).unwrap_or(0);
+                let (s, x) = found.swap_remove(best);
+                tick();
+                Some((s, x, scores[best]))
+            }
+        })
+        .collect()
 }
 
 fn record(

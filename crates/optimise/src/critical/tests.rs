@@ -491,3 +491,70 @@ fn a_search_without_a_design_has_four_times_the_box_budget() {
         );
     }
 }
+
+/// The spring choice evaluates every run's options in one pass over the union of the runs'
+/// tasks. Each group must get exactly (bit for bit) what it gets evaluated on its own, over
+/// its own tasks only: groups here differ in their spring slots (to the base and between
+/// bodies), counterweights and tasks, and share some tasks; the reference is the per-group
+/// evaluation the spring choice used before.
+#[test]
+fn batched_reaction_peaks_equal_each_group_on_its_own() {
+    let model = model(&case_json("palletizer.json"));
+    let ctx = Context::new(&model, None).unwrap();
+    let spring = |body: usize, other: Option<usize>, stiffness: f64| Spring {
+        body,
+        other,
+        stiffness,
+        anchor: [0.1, 0.02, 0.0],
+        other_anchor: [-0.05, 0.3, 0.0],
+    };
+    let cw = |body: usize, mass: f64| Counterweight {
+        body,
+        mass,
+        position: [-0.3, 0.05, 0.0],
+    };
+    let a = vec![
+        Variant {
+            counterweights: vec![cw(2, 40.0)],
+            springs: vec![spring(4, Some(5), 900.0)],
+        },
+        Variant {
+            counterweights: vec![],
+            springs: vec![spring(3, None, 2500.0), spring(6, Some(4), 300.0)],
+        },
+    ];
+    let b = vec![Variant {
+        counterweights: vec![cw(4, 120.0), cw(6, 15.0)],
+        springs: vec![],
+    }];
+    let c = vec![
+        Variant {
+            counterweights: vec![],
+            springs: vec![spring(5, None, 1200.0)],
+        },
+        Variant {
+            counterweights: vec![],
+            springs: vec![spring(5, None, 1300.0)],
+        },
+    ];
+    let n = ctx.tasks.len();
+    let (ta, tb, tc) = (vec![0, 5, n / 3, n - 1], vec![5, n / 3, n / 2], vec![7]);
+    let groups: Vec<(&[Variant], &[usize])> = vec![(&a, &ta), (&b, &tb), (&c, &tc)];
+    let batched = batched_reaction_peaks(&ctx, &groups);
+    assert_eq!(batched.len(), 3);
+    for ((variants, tasks), got) in groups.iter().zip(&batched) {
+        let alone = reaction_peaks(&ctx, variants, tasks).unwrap();
+        let got = got.as_ref().unwrap();
+        assert_eq!(got.len(), variants.len());
+        for (g, r) in got.iter().zip(&alone) {
+            // a real evaluation: the first joint carries load in every pose
+            assert!(r.0[0] > 0.0);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&g.0), bits(&r.0));
+            assert_eq!(bits(&g.1), bits(&r.1));
+        }
+    }
+    // Group c alone over group a's tasks differs: each group is taken over its own tasks.
+    let over_a = reaction_peaks(&ctx, &c, &ta).unwrap();
+    assert_ne!(over_a, *batched[2].as_ref().unwrap());
+}
