@@ -1043,9 +1043,22 @@ fn apply_operator_kernel(
         operator_rows::<6, LANE>(op, nr, nk, b, ld, out, c0);
         c0 += LANE;
     }
-    while c0 < m {
-        operator_rows::<1, 1>(op, nr, nk, b, ld, out, c0);
-        c0 += 1;
+    if c0 < m {
+        // The last `m − c0 < LANE` columns go through the one-vector tile too, copied into a
+        // zero-padded block one lane wide (the padding's results are dropped). One column at
+        // a time, each value is a single chain of dependent multiply-adds, bound by their
+        // latency: a grid batch's remainder columns (and Phase 1's one column) took most of
+        // this kernel's time. Each kept value is the same chain, so the same bits.
+        let rem = m - c0;
+        let mut block = vec![0.0; nk * LANE];
+        for k in 0..nk {
+            block[k * LANE..k * LANE + rem].copy_from_slice(&b[k * ld + c0..k * ld + m]);
+        }
+        let mut result = vec![0.0; nr * LANE];
+        operator_rows::<6, LANE>(op, nr, nk, &block, LANE, &mut result, 0);
+        for r in 0..nr {
+            out[r * ld + c0..r * ld + m].copy_from_slice(&result[r * LANE..r * LANE + rem]);
+        }
     }
 }
 }
