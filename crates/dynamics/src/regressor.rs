@@ -223,12 +223,32 @@ impl SampleRegressor {
         }
     }
 
-    /// `Q_q = Y π` for one column into `out` (length n).
+    /// `Q_q = Y π` for one column into `out` (length n): the products summed in row order.
+    ///
+    /// A spring slot the column does not use (all its parameters zero) only adds zeros, which
+    /// leave a non-zero sum's bits unchanged: it is skipped, so that a column costs the same
+    /// in a batch whose columns use many slots (the spring choice evaluates the options of
+    /// every run in one batch) as on its own. While the sum is still exactly zero every term is
+    /// added, so even the sign of a zero is the same.
     pub fn generalized_force(&self, n: usize, column: &[f64], out: &mut [f64; MAX_VARS]) {
         let rows = column.len();
+        let body_rows = (BODY_PARAMS * self.kin.len()).min(rows);
+        let (body, springs) = column.split_at(body_rows);
         for q in 0..n {
-            let row = &self.y[q * rows..(q + 1) * rows];
-            out[q] = row.iter().zip(column).map(|(a, b)| a * b).sum();
+            let row = &self.y[q * rows..q * rows + body_rows];
+            out[q] = row.iter().zip(body).map(|(a, b)| a * b).sum();
+        }
+        for (s, x) in springs.chunks(SPRING_PARAMS).enumerate() {
+            let used = x.iter().any(|&v| v != 0.0);
+            let off = body_rows + s * SPRING_PARAMS;
+            for q in 0..n {
+                if used || out[q] == 0.0 {
+                    let y = &self.y[q * rows + off..q * rows + off + x.len()];
+                    for (a, b) in y.iter().zip(x) {
+                        out[q] += a * b;
+                    }
+                }
+            }
         }
     }
 }
