@@ -182,6 +182,9 @@ pub struct StageTimings {
     pub loop_grid: StageTime,
     /// Spring choice by ΔR on the reaction tasks.
     pub spring_choice: StageTime,
+    /// Of the spring choice, the joint reactions of the options on the reaction tasks (the
+    /// rest is the realization of the options).
+    pub spring_reactions: StageTime,
     /// Final all-task evaluation (torques and joint reactions).
     pub final_grid: StageTime,
     /// Verification and records.
@@ -1192,7 +1195,14 @@ fn finish(
         joint_tasks.extend(ctx.task_index(j.moment_task));
     }
     let counter = StageCounter::start(progress, "spring choice", 0, runs.len());
-    let choices = spring_choices(ctx, &runs, &joint_tasks, options, &|| counter.tick());
+    let choices = spring_choices(
+        ctx,
+        &runs,
+        &joint_tasks,
+        options,
+        &|| counter.tick(),
+        &mut timings.spring_reactions,
+    );
     for (run, choice) in runs.iter_mut().zip(&choices) {
         if let (Some(c), Some((s, x, _))) = (run.candidate.as_mut(), choice) {
             c.springs = s.clone();
@@ -1244,9 +1254,18 @@ fn spring_choice(
     joint_tasks: &BTreeSet<usize>,
     options: &OptimiseOptions,
 ) -> Option<SpringChoice> {
-    spring_choices(ctx, std::slice::from_ref(run), joint_tasks, options, &|| ())
-        .pop()
-        .flatten()
+    let mut reactions = StageTime::default();
+    let tick = || ();
+    spring_choices(
+        ctx,
+        std::slice::from_ref(run),
+        joint_tasks,
+        options,
+        &tick,
+        &mut reactions,
+    )
+    .pop()
+    .flatten()
 }
 
 /// What the spring choice of one run needs.
@@ -1317,13 +1336,14 @@ fn spring_options(
 /// reaction tasks (see [`lowest_delta_r`]). The options are realized run by run in parallel;
 /// their reactions are then evaluated in one batch over all the runs' tasks
 /// ([`batched_reaction_peaks`], the same bits as run by run). `tick` is called once per run as
-/// its choice is known.
+/// its choice is known; the time of the reactions is added to `reactions_time`.
 fn spring_choices(
     ctx: &Context,
     runs: &[Run],
     joint_tasks: &BTreeSet<usize>,
     options: &OptimiseOptions,
     tick: &(dyn Fn() + Sync),
+    reactions_time: &mut StageTime,
 ) -> Vec<Option<SpringChoice>> {
     let prepared: Vec<SpringOptions> = runs
         .par_iter()
@@ -1344,7 +1364,9 @@ fn spring_choices(
             _ => None,
         })
         .collect();
+    let started = Stopwatch::start();
     let mut peaks = batched_reaction_peaks(ctx, &groups).into_iter();
+    *reactions_time += started.elapsed();
     prepared
         .into_iter()
         .map(|o| match o {
