@@ -94,3 +94,64 @@ where
     }
     (anchors, rows)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::element::Attachment;
+    use crate::exact::ExactBasis;
+    use counterpoise_symbolic::{Monomial, Rational};
+
+    /// A spring's variables `(K, αx, αy, βx, βy, Wxx, Wxy, Wyx, Wyy)` with the hand-written
+    /// balance equations `αy = 2·K` and `βx = 3·K`: `ay = 2` and `bx = 3` are fixed, `ax` and
+    /// `by` free. A physical spring then has row y of `W` equal to `2·β` (`Wyx − 2βx = 0`,
+    /// `Wyy − 2βy = 0`) and column x equal to `3·α` (`Wxx − 3αx = 0`, `Wyx − 3αy = 0`).
+    #[test]
+    fn fixed_components_give_their_row_and_column_of_w() {
+        let int = |v: &[i64]| -> Vec<num_bigint::BigInt> { v.iter().map(|&x| x.into()).collect() };
+        let q = |n: i64| Rational::from_integer(n.into());
+        let mut columns = vec![int(&[0, 0]); 9];
+        columns[0] = int(&[-2, -3]);
+        columns[2] = int(&[1, 0]);
+        columns[3] = int(&[0, 1]);
+        let basis = ExactBasis {
+            monomials: vec![Monomial::sine(0), Monomial::sine(1)],
+            unbalanced: int(&[0, 0]),
+            elements: vec![columns],
+            row_factors: vec![q(1), q(1)],
+        };
+        let entry = CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0, 1],
+                axes_b: vec![0, 1],
+            },
+            label: "K1".into(),
+            description: "a spring".into(),
+            variables: Vec::new(),
+            energy: Vec::new(),
+        };
+        let (anchors, rows) = fixed_anchor_equations(&basis.solve(&[0]), &[(0, &entry)]);
+        assert_eq!(
+            anchors,
+            vec!["K1's anchor components a = (free, 2) and b = (3, free)".to_string()]
+        );
+        let row = |terms: &[(usize, i64)]| {
+            let mut r = vec![q(0); 9];
+            for &(j, c) in terms {
+                r[j] = q(c);
+            }
+            r
+        };
+        assert_eq!(
+            rows,
+            vec![
+                row(&[(7, 1), (3, -2)]),
+                row(&[(8, 1), (4, -2)]),
+                row(&[(5, 1), (1, -3)]),
+                row(&[(7, 1), (2, -3)]),
+            ]
+        );
+    }
+}
