@@ -143,6 +143,9 @@ pub struct ConicProblem {
     rows: Vec<Row>,
     rhs: Vec<f64>,
     cones: Vec<Cone>,
+    /// Optimality and feasibility tolerance of the first runs, when not clarabel's 1e-8 (see
+    /// [`ConicProblem::set_tolerance`]).
+    tolerance: Option<f64>,
 }
 
 /// The outcome of a solve.
@@ -218,6 +221,14 @@ impl ConicProblem {
         self.cones.push(Cone::Pow(alpha));
     }
 
+    /// Solves to `tol` (gap and feasibility) instead of clarabel's 1e-8; the retries use the
+    /// looser of theirs and this. For a problem whose value is only used as a bound with a
+    /// margin of ten times the tolerance (a branch-and-bound box, see
+    /// [`crate::relaxation::BOUND_MARGIN`]), the last two digits are wasted work.
+    pub fn set_tolerance(&mut self, tol: f64) {
+        self.tolerance = Some(tol);
+    }
+
     pub fn rows(&self) -> usize {
         self.rows.len()
     }
@@ -286,6 +297,11 @@ impl ConicProblem {
             max_iter,
             ..DefaultSettings::default()
         };
+        if let Some(tol) = self.tolerance {
+            settings.tol_gap_abs = tol;
+            settings.tol_gap_rel = tol;
+            settings.tol_feas = tol;
+        }
         if attempt >= 1 {
             settings.max_iter = max_iter.saturating_mul(3);
             settings.max_step_fraction = 0.9;
@@ -293,6 +309,7 @@ impl ConicProblem {
         }
         if attempt >= 2 {
             let tol: f64 = if attempt >= 3 { 1e-6 } else { 1e-7 };
+            let tol = tol.max(self.tolerance.unwrap_or(0.0));
             settings.tol_gap_abs = tol;
             settings.tol_gap_rel = tol;
             settings.tol_feas = tol;
