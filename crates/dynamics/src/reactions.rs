@@ -581,19 +581,6 @@ impl ReactionSolver {
         m: usize,
         out: &mut [f64],
     ) {
-        self.solve_prepared_with(work, b, m, out, false);
-    }
-
-    /// [`Self::solve_prepared`]; `identity`: `b` is the identity (`m` = `6L`), which lets the
-    /// forward substitution start each chunk of right-hand sides at its first non-zero row.
-    fn solve_prepared_with(
-        &self,
-        work: &mut ReactionWork,
-        b: &mut [f64],
-        m: usize,
-        out: &mut [f64],
-        identity: bool,
-    ) {
         let rows = work.rows;
         let k = work.k;
         if let Some(pinv) = &work.pinv {
@@ -622,18 +609,7 @@ impl ReactionSolver {
                 stride: work.stride,
                 inv_diag: &work.inv_diag,
             };
-            let leading_zeros = identity && m == rows;
-            chunk_solve(
-                factor,
-                &work.a,
-                &work.nz,
-                k,
-                b,
-                m,
-                leading_zeros,
-                &mut work.y,
-                &mut work.z,
-            );
+            chunk_solve(factor, &work.a, &work.nz, k, b, m, &mut work.y, &mut work.z);
         }
         // Each output row is the sum of its basis vectors' contributions in a fixed order. The
         // first contribution is written as `0.0 + e·λ` — the bits of adding it to a zeroed
@@ -690,7 +666,7 @@ impl ReactionSolver {
         }
         let mut op = std::mem::take(&mut work.op);
         op.resize(6 * self.joints.len() * rows, 0.0);
-        self.solve_prepared_with(work, &mut unit, rows, &mut op, true);
+        self.solve_prepared(work, &mut unit, rows, &mut op);
         work.op = op;
         work.unit = unit;
     }
@@ -915,11 +891,6 @@ crate::simd::multiversion! {
 /// `k × m`), [`LANE`] right-hand sides at a time. Both substitutions
 /// are in dot-product form over contiguous rows: the inner loop keeps four independent
 /// accumulators in registers and stores each unknown once.
-///
-/// `leading_zeros`: every right-hand side `c` is zero in rows `0 .. c` (the identity of
-/// [`ReactionSolver::prepare_operator`]), so the forward substitution of the chunk starting
-/// at column `c0` starts at row `c0`; see [`solve_lanes`] for why the bits are the same.
-#[allow(clippy::too_many_arguments)]
 fn chunk_solve(
     factor: Factor<'_>,
     a: &[f64],
@@ -927,14 +898,12 @@ fn chunk_solve(
     k: usize,
     b: &[f64],
     m: usize,
-    leading_zeros: bool,
     y: &mut [f64],
     z: &mut SolveScratch,
 ) {
     z.z.resize(factor.rows, Lanes::default());
     for c0 in (0..m).step_by(LANE) {
-        let start = if leading_zeros { c0 } else { 0 };
-        solve_lanes(factor, a, nz, k, b, m, c0, start, y, &mut z.z);
+        solve_lanes(factor, a, nz, k, b, m, c0, y, &mut z.z);
     }
 }
 }
@@ -949,24 +918,14 @@ fn solve_lanes(
     b: &[f64],
     m: usize,
     c0: usize,
-    start: usize,
     y: &mut [f64],
     z: &mut [Lanes],
 ) {
     let rows = factor.rows;
     let width = LANE.min(m - c0);
-    // L z = b: z_i = (b_i − Σ_{j<i} L_ij z_j) / L_ii.
-    //
-    // Rows below `start` (a multiple of four) are zero in every lane of `b`: their unknowns are
-    // exactly +0 (each partial sum of `combo` stays +0, `(0 − 0)·d = +0`), and their terms add
-    // +0 or −0 to partial sums that are +0. Starting the sums at `start` keeps each term in
-    // the same one of the four partial sums and drops only those zero terms: the same bits.
-    debug_assert!(start.is_multiple_of(4) && start <= rows);
-    for zi in &mut z[..start] {
-        *zi = Lanes([0.0; LANE]);
-    }
-    for i in start..rows {
-        let s = combo(&factor.l[i * rows + start..i * rows + i], &z[start..i]);
+    // L z = b: z_i = (b_i − Σ_{j<i} L_ij z_j) / L_ii
+    for i in 0..rows {
+        let s = combo(&factor.l[i * rows..i * rows + i], &z[..i]);
         let d = factor.inv_diag[i];
         let mut zi = [0.0; LANE];
         zi[..width].copy_from_slice(&b[i * m + c0..i * m + c0 + width]);
@@ -1244,56 +1203,6 @@ mod tests {
                         "s = {s}, ρ = {rho}: A⁺ = {pinv}"
                     );
                 }
-            }
-        }
-    }
-
-    /// The operator's forward substitution starts each chunk of unit right-hand sides at its
-    /// first non-zero row; the general solve of the same identity runs every row. Same bits
-    /// at configurations across the palletizer's grid.
-    #[test]
-    fn the_operator_skips_only_zero_rows_of_the_identity() {
-        use crate::lu::SmallLu;
-        use crate::mechanism::Scratch;
-        use counterpoise_symbolic::MAX_VARS;
-        let path = format!("{}/../../cases/palletizer.json", env!("CARGO_MANIFEST_DIR"));
-        let model = Case::from_path(std::path::Path::new(&path)).unwrap();
-        let ev = Evaluator::new(&model).unwrap();
-        let mech = &ev.mech;
-        let tasks = model.tasks.as_ref().unwrap();
-        for frac in [0.0, 0.3, 0.77] {
-            let u: Vec<f64> = tasks
-                .grid
-                .iter()
-                .map(|a| a.from + frac * (a.to - a.from))
-                .collect();
-            let q = ev.solve_point(&u).unwrap();
-            let mut scratch = Scratch::default();
-            let mut f = [0.0; MAX_VARS];
-            let mut g = [0.0; MAX_VARS * MAX_VARS];
-            mech.actuator_map(&q, &mut scratch, &mut f, &mut g);
-            let lu = SmallLu::new(&g, mech.n);
-            mech.eval_poses(&q, &mut scratch);
-            let pose = scratch.pose.clone();
-            let kin: Vec<_> = (0..mech.body_count)
-                .map(|b| mech.body_frame(&pose, b))
-                .collect();
-            let mut work = super::ReactionWork::default();
-            ev.reactions.prepare(mech, &pose, &kin, &lu, &mut work);
-            assert!(work.pinv.is_none(), "the fast path");
-            let rows = work.rows;
-            let mut identity = vec![0.0; rows * rows];
-            for i in 0..rows {
-                identity[i * rows + i] = 1.0;
-            }
-            let mut plain = vec![0.0; 6 * ev.reactions.joint_count() * rows];
-            ev.reactions
-                .solve_prepared(&mut work, &mut identity, rows, &mut plain);
-            ev.reactions.prepare_operator(&mut work);
-            assert_eq!(work.op.len(), plain.len());
-            assert!(plain.iter().any(|&x| x != 0.0));
-            for (x, y) in work.op.iter().zip(&plain) {
-                assert_eq!(x.to_bits(), y.to_bits());
             }
         }
     }
