@@ -553,4 +553,44 @@ mod tests {
         assert_eq!(part, "ay");
         assert!(text.contains("·K") && text.contains("·K·by"), "{text}");
     }
+    /// The column version: the single row `βy + 2·Wyy = 0` says `by·(K + 2·αy) = 0`
+    /// (`βy = by·K`, `Wyy = αy·by`), with the branches `βy = 0, Wxy = Wyy = 0` and
+    /// `K + 2·αy = 0`.
+    #[test]
+    fn a_column_identity_splits_into_a_zero_part_or_the_other_factor() {
+        let mut columns = vec![vec![BigInt::from(0)]; 9];
+        columns[4] = vec![BigInt::from(1)];
+        columns[8] = vec![BigInt::from(2)];
+        let basis = ExactBasis {
+            monomials: vec![Monomial::sine(0)],
+            unbalanced: vec![BigInt::from(0)],
+            elements: vec![columns],
+            row_factors: vec![Rational::from_integer(1.into())],
+        };
+        let solution = basis.solve(&[0]);
+        let entry = spring();
+        let entries = [(0, &entry)];
+        let found = factors(&solution, &entries);
+        assert_eq!(found.len(), 1);
+        let f = &found[0];
+        assert!(!f.side_a && f.index == 1, "column y of b");
+        let q = |n: i64| Rational::from_integer(n.into());
+        let c = f.coefficients[0].clone();
+        assert_ne!(c, q(0));
+        let scaled: Vec<Rational> = f.coefficients.iter().map(|v| v / &c).collect();
+        assert_eq!(scaled, vec![q(1), q(0), q(2)]);
+        assert_eq!(
+            zeroed(&factor_rows(&solution, &entries, f, true)),
+            vec![4, 6, 8]
+        );
+        let other = factor_rows(&solution, &entries, f, false);
+        let row: Vec<Rational> = other[0].iter().map(|v| v / &c).collect();
+        let mut expected = vec![q(0); 9];
+        expected[0] = q(1);
+        expected[2] = q(2);
+        assert_eq!(row, expected, "K + 2·αy = 0");
+        let (part, text) = factor_text(&entry, f);
+        assert_eq!(part, "by");
+        assert!(text.contains("·K·ay"), "{text}");
+    }
 }
