@@ -12,7 +12,6 @@
 //! not positive.
 
 use counterpoise_model::sampling::SplitMix64;
-use std::ops::AddAssign;
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -215,10 +214,11 @@ pub fn find_witness_on(
         unknowns += physical_len(&entry.element);
     }
     let held = held_unknowns(&slots, unknowns, zero_columns);
+    let scale = 1.0 / b.norm().max(f64::MIN_POSITIVE);
     let problem = Problem {
         hints,
-        matrix: &solution.matrix,
-        b,
+        scaled: &solution.matrix * scale,
+        scaled_b: b * scale,
         slots: &slots,
         unknowns,
         held: &held,
@@ -433,8 +433,13 @@ fn physical_len(element: &Element) -> usize {
 
 struct Problem<'a> {
     hints: RealizationHints,
-    matrix: &'a DMatrix<f64>,
-    b: &'a DVector<f64>,
+    /// The lifted matrix times `1/‖b‖`, scaled once here: `evaluate` runs at every
+    /// Levenberg–Marquardt step and used to allocate each scaled column afresh (a quarter of
+    /// the balance search's time). Each entry is the same product `a_ij · (1/‖b‖)`, so the bits
+    /// are those of the per-step scaling.
+    scaled: DMatrix<f64>,
+    /// `b / ‖b‖`, entry by entry the same product as the matrix.
+    scaled_b: DVector<f64>,
     slots: &'a [Slot<'a>],
     unknowns: usize,
     /// Unknowns held at zero (their Jacobian columns are zero, so no step moves them).
@@ -448,25 +453,46 @@ impl Problem<'_> {
     // Index loops mirror the formulas (a_k, b_l, W_kl) more clearly than zipped iterators.
     #[allow(clippy::needless_range_loop)]
     fn evaluate(&self, y: &DVector<f64>, pull: f64) -> (DVector<f64>, DMatrix<f64>) {
-        let scale = 1.0 / self.b.norm().max(f64::MIN_POSITIVE);
-        let rows = self.matrix.nrows();
+        let rows = self.scaled.nrows();
         let extra = if pull > 0.0 { self.unknowns } else { 0 };
-        let mut r = DVector::zeros(rows + extra);
-        r.rows_mut(0, rows).copy_from(&(self.b * scale));
-        let mut jac = DMatrix::zeros(rows + extra, self.unknowns);
+        let height = rows + extra;
+        let mut r = DVector::zeros(height);
+        r.as_mut_slice()[..rows].copy_from_slice(self.scaled_b.as_slice());
+        let mut jac = DMatrix::zeros(height, self.unknowns);
+        // Plain slice loops, one scratch column per spring: the same products and sums, in the
+        // same order, as the former column-vector expressions, without an allocation per term.
+        let matrix = self.scaled.as_slice();
+        let mut unit = vec![0.0; rows];
+        let mut d = vec![0.0; rows];
         for slot in self.slots {
-            let col = |j: usize| self.matrix.column(slot.column + j) * scale;
+            let col = |j: usize| {
+                let start = (slot.column + j) * rows;
+                &matrix[start..start + rows]
+            };
             match &slot.entry.element {
                 Element::Counterweight { axes, .. } => {
                     let m = y[slot.unknown].exp();
-                    let dm = col(0) * m;
-                    r.rows_mut(0, rows).add_assign(&dm);
-                    jac.view_mut((0, slot.unknown), (rows, 1)).copy_from(&dm);
+                    {
+                        let (r, jac) = (r.as_mut_slice(), jac.as_mut_slice());
+                        let jcol = &mut jac[slot.unknown * height..slot.unknown * height + rows];
+                        for ((ri, ji), &c) in r.iter_mut().zip(jcol.iter_mut()).zip(col(0)) {
+                            let dm = c * m;
+                            *ri += dm;
+                            *ji = dm;
+                        }
+                    }
                     for k in 0..axes.len() {
-                        let mu = y[slot.unknown + 1 + k];
-                        r.rows_mut(0, rows).add_assign(&(col(1 + k) * mu));
-                        jac.view_mut((0, slot.unknown + 1 + k), (rows, 1))
-                            .copy_from(&col(1 + k));
+                        let u = slot.unknown + 1 + k;
+                        let mu = y[u];
+                        let (r, jac) = (r.as_mut_slice(), jac.as_mut_slice());
+                        for ((ri, ji), &c) in r
+                            .iter_mut()
+                            .zip(jac[u * height..u * height + rows].iter_mut())
+                            .zip(col(1 + k))
+                        {
+                            *ri += c * mu;
+                            *ji = c;
+                        }
                     }
                     if pull > 0.0 {
                         let row = rows + slot.unknown;
@@ -488,36 +514,54 @@ impl Problem<'_> {
                     let bb: Vec<f64> = (0..nb).map(|l| y[slot.unknown + 1 + na + l]).collect();
                     let w = |k: usize, l: usize| 1 + na + nb + k * nb + l;
                     // contribution per unit K: φ_K + Σ a_k φ_αk + Σ b_l φ_βl + Σ a_k b_l φ_Wkl
-                    let mut unit = col(0);
+                    unit.copy_from_slice(col(0));
                     for k in 0..na {
-                        unit += col(1 + k) * a[k];
+                        add_scaled(&mut unit, col(1 + k), a[k]);
                     }
                     for l in 0..nb {
-                        unit += col(1 + na + l) * bb[l];
+                        add_scaled(&mut unit, col(1 + na + l), bb[l]);
                     }
                     for k in 0..na {
                         for l in 0..nb {
-                            unit += col(w(k, l)) * (a[k] * bb[l]);
+                            add_scaled(&mut unit, col(w(k, l)), a[k] * bb[l]);
                         }
                     }
-                    r.rows_mut(0, rows).add_assign(&(&unit * stiffness));
-                    jac.view_mut((0, slot.unknown), (rows, 1))
-                        .copy_from(&(&unit * stiffness));
-                    for k in 0..na {
-                        let mut d = col(1 + k);
-                        for l in 0..nb {
-                            d += col(w(k, l)) * bb[l];
+                    {
+                        let u = slot.unknown;
+                        let (r, jac) = (r.as_mut_slice(), jac.as_mut_slice());
+                        for ((ri, ji), &x) in r
+                            .iter_mut()
+                            .zip(jac[u * height..u * height + rows].iter_mut())
+                            .zip(unit.iter())
+                        {
+                            let v = x * stiffness;
+                            *ri += v;
+                            *ji = v;
                         }
-                        jac.view_mut((0, slot.unknown + 1 + k), (rows, 1))
-                            .copy_from(&(d * stiffness));
+                    }
+                    for k in 0..na {
+                        d.copy_from_slice(col(1 + k));
+                        for l in 0..nb {
+                            add_scaled(&mut d, col(w(k, l)), bb[l]);
+                        }
+                        let u = slot.unknown + 1 + k;
+                        scale_into(
+                            &mut jac.as_mut_slice()[u * height..u * height + rows],
+                            &d,
+                            stiffness,
+                        );
                     }
                     for l in 0..nb {
-                        let mut d = col(1 + na + l);
+                        d.copy_from_slice(col(1 + na + l));
                         for k in 0..na {
-                            d += col(w(k, l)) * a[k];
+                            add_scaled(&mut d, col(w(k, l)), a[k]);
                         }
-                        jac.view_mut((0, slot.unknown + 1 + na + l), (rows, 1))
-                            .copy_from(&(d * stiffness));
+                        let u = slot.unknown + 1 + na + l;
+                        scale_into(
+                            &mut jac.as_mut_slice()[u * height..u * height + rows],
+                            &d,
+                            stiffness,
+                        );
                     }
                     if pull > 0.0 {
                         let row = rows + slot.unknown;
@@ -635,7 +679,7 @@ impl Problem<'_> {
                 break;
             }
         }
-        let balance = r.rows(0, self.matrix.nrows()).norm();
+        let balance = r.rows(0, self.scaled.nrows()).norm();
         (y, balance)
     }
 
@@ -689,5 +733,19 @@ impl Problem<'_> {
             }
         }
         witness
+    }
+}
+
+/// `acc += x · c`, entry by entry (the product first, then the sum: the order of `acc += &x * c`).
+fn add_scaled(acc: &mut [f64], x: &[f64], c: f64) {
+    for (a, &v) in acc.iter_mut().zip(x) {
+        *a += v * c;
+    }
+}
+
+/// `out = x · c`, entry by entry.
+fn scale_into(out: &mut [f64], x: &[f64], c: f64) {
+    for (o, &v) in out.iter_mut().zip(x) {
+        *o = v * c;
     }
 }
