@@ -593,4 +593,36 @@ mod tests {
         assert_eq!(part, "by");
         assert!(text.contains("·K·ay"), "{text}");
     }
+    /// Rows `αy + 2·Wyy = 0` and `Wyx − Wyy = 0`: over the family `(αy, Wyx, Wyy)` moves along
+    /// `(−2, 1, 1)` only, so row y of `a` has exactly two independent identities, `(1, 0, 2)` and
+    /// `(0, 1, −1)`, and no other row or column has one.
+    #[test]
+    fn identities_are_the_null_space_of_the_family_directions() {
+        let mut columns = vec![vec![BigInt::from(0); 2]; 9];
+        columns[2] = vec![BigInt::from(1), BigInt::from(0)];
+        columns[7] = vec![BigInt::from(0), BigInt::from(1)];
+        columns[8] = vec![BigInt::from(2), BigInt::from(-1)];
+        let basis = ExactBasis {
+            monomials: vec![Monomial::sine(0), Monomial::sine(1)],
+            unbalanced: vec![BigInt::from(0); 2],
+            elements: vec![columns],
+            row_factors: vec![Rational::from_integer(1.into()); 2],
+        };
+        let solution = basis.solve(&[0]);
+        let entry = spring();
+        let found = factors(&solution, &[(0, &entry)]);
+        assert_eq!(found.len(), 2);
+        assert!(found.iter().all(|f| f.side_a && f.index == 1));
+        let q = |n: i64| Rational::from_integer(n.into());
+        let dot = |f: &Factor<Rational>, v: [i64; 3]| {
+            f.coefficients
+                .iter()
+                .zip(v)
+                .fold(q(0), |acc, (c, x)| acc + c * q(x))
+        };
+        for f in &found {
+            assert_eq!(dot(f, [-2, 1, 1]), q(0), "an identity along the family");
+        }
+        assert_ne!(found[0].coefficients, found[1].coefficients);
+    }
 }
