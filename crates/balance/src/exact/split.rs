@@ -445,6 +445,18 @@ mod tests {
         basis.solve(&[0])
     }
 
+    /// The one-spring basis with the given columns (one entry per balance row) and a zero
+    /// unbalanced energy: every row reads `Σ columns[j][r]·x_j = 0`.
+    fn homogeneous(columns: Vec<Vec<BigInt>>) -> ExactBasis<Rational> {
+        let rows = columns[0].len();
+        ExactBasis {
+            monomials: (0..rows).map(Monomial::sine).collect(),
+            unbalanced: vec![BigInt::from(0); rows],
+            elements: vec![columns],
+            row_factors: vec![Rational::from_integer(1.into()); rows],
+        }
+    }
+
     /// The variables a branch sets to zero (each row is a unit row).
     fn zeroed(rows: &[Vec<Rational>]) -> Vec<usize> {
         let zero = Rational::from_integer(0.into());
@@ -518,12 +530,7 @@ mod tests {
         let mut columns = vec![vec![BigInt::from(0)]; 9];
         columns[2] = vec![BigInt::from(1)];
         columns[8] = vec![BigInt::from(2)];
-        let basis = ExactBasis {
-            monomials: vec![Monomial::sine(0)],
-            unbalanced: vec![BigInt::from(0)],
-            elements: vec![columns],
-            row_factors: vec![Rational::from_integer(1.into())],
-        };
+        let basis = homogeneous(columns);
         let solution = basis.solve(&[0]);
         let entry = spring();
         let entries = [(0, &entry)];
@@ -561,12 +568,7 @@ mod tests {
         let mut columns = vec![vec![BigInt::from(0)]; 9];
         columns[4] = vec![BigInt::from(1)];
         columns[8] = vec![BigInt::from(2)];
-        let basis = ExactBasis {
-            monomials: vec![Monomial::sine(0)],
-            unbalanced: vec![BigInt::from(0)],
-            elements: vec![columns],
-            row_factors: vec![Rational::from_integer(1.into())],
-        };
+        let basis = homogeneous(columns);
         let solution = basis.solve(&[0]);
         let entry = spring();
         let entries = [(0, &entry)];
@@ -602,12 +604,7 @@ mod tests {
         columns[2] = vec![BigInt::from(1), BigInt::from(0)];
         columns[7] = vec![BigInt::from(0), BigInt::from(1)];
         columns[8] = vec![BigInt::from(2), BigInt::from(-1)];
-        let basis = ExactBasis {
-            monomials: vec![Monomial::sine(0), Monomial::sine(1)],
-            unbalanced: vec![BigInt::from(0); 2],
-            elements: vec![columns],
-            row_factors: vec![Rational::from_integer(1.into()); 2],
-        };
+        let basis = homogeneous(columns);
         let solution = basis.solve(&[0]);
         let entry = spring();
         let found = factors(&solution, &[(0, &entry)]);
