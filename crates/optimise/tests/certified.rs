@@ -191,3 +191,30 @@ fn the_hybrid_optimum_known_in_closed_form_is_reached_from_every_start() {
         );
     }
 }
+
+/// The same hybrid with a lower norm bound on the spring's rod anchor, `|a| ∈ [0.25, 0.3]` m:
+/// the optimum is unchanged (the spring still carries its most at `|a| = 0.3 m`), and the
+/// search must reach it with the anchor outside the excluded disc (the relaxation drops that
+/// non-convex bound, the search restores it by splitting).
+#[test]
+fn a_hybrid_with_an_anchor_floor_reaches_the_hand_optimum() {
+    let mu = (MOMENT - 6.0) / G;
+    let f_star = (0..=200_000)
+        .map(|k| objective(mu + (5.0 - mu) * k as f64 / 200_000.0, mu))
+        .fold(f64::INFINITY, f64::min);
+    let json = case([1.0, 100.0], [0.25, 0.3], [0.0, 0.2], true);
+    let options = OptimiseOptions {
+        max_nodes: 4000,
+        ..OptimiseOptions::default()
+    };
+    let v = run(&json, &["m1", "K10"], &options);
+    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    let value = v.objective.unwrap();
+    assert!(v.gap.unwrap() <= 1e-3, "gap {:?}", v.gap);
+    assert!(v.lower_bound.unwrap() <= f_star * (1.0 + 1e-9));
+    assert!(
+        value >= f_star * (1.0 - 1e-9) && value <= f_star * (1.0 + 1e-3),
+        "{value} vs optimum {f_star}"
+    );
+    assert!(norm(v.springs[0].anchor_a) >= 0.25 * (1.0 - 1e-12));
+}
