@@ -185,19 +185,34 @@ where
     // z_pivot = (t − target.constant − Σ_{k≠pivot} g_k z_k) / g_pivot; the variables become
     // (z without pivot, t), t last.
     let g = &target.coefficients;
+    // A constraint without the pivot is unchanged but for the new variable's zero, and a zero
+    // of `g` leaves its coefficient as it is: both skip the exact products (most constraints
+    // of a balanced family hold a few of its free parameters).
     let substitute = |f: &Affine<F>| -> Affine<F> {
         let ratio = &f.coefficients[pivot] / &g[pivot];
+        let keep = ratio.is_zero();
         let mut coefficients: Vec<F> = f
             .coefficients
             .iter()
             .zip(g)
             .enumerate()
             .filter(|(k, _)| *k != pivot)
-            .map(|(_, (fk, gk))| fk - &ratio * gk)
+            .map(|(_, (fk, gk))| {
+                if keep || gk.is_zero() {
+                    fk.clone()
+                } else {
+                    fk - &ratio * gk
+                }
+            })
             .collect();
         coefficients.push(ratio.clone());
+        let constant = if keep || target.constant.is_zero() {
+            f.constant.clone()
+        } else {
+            &f.constant - &ratio * &target.constant
+        };
         Affine {
-            constant: &f.constant - &ratio * &target.constant,
+            constant,
             coefficients,
         }
     };
