@@ -359,3 +359,46 @@ fn nelder_mead(
     simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
     (simplex[0].0.clone(), simplex[0].1 < f0)
 }
+
+/// The free coordinates `z` of a lifted point of the family (`x = x_p + N z`, least squares;
+/// `N` has full column rank). `None` when the decomposition fails.
+pub fn free_coordinates(problem: &VariantProblem, x: &DVector<f64>) -> Option<DVector<f64>> {
+    let offset = x - &problem.particular;
+    checked_svd(problem.nullspace.clone(), true)?
+        .solve(&offset, 1e-12)
+        .ok()
+}
+
+/// Nelder–Mead from `z0` along `directions` on any merit (`+∞` where it is undefined), with
+/// the restarts of [`refine`]; the best point met and its merit.
+pub fn minimise_along(
+    z0: &DVector<f64>,
+    directions: &DMatrix<f64>,
+    mut merit_at: impl FnMut(&DVector<f64>) -> f64,
+) -> (DVector<f64>, f64) {
+    let mut best = (z0.clone(), merit_at(z0));
+    let n = directions.ncols();
+    if n == 0 {
+        return best;
+    }
+    let mut evaluations = 1;
+    let mut f = |y: &DVector<f64>, _: &mut usize| {
+        let z = z0 + directions * y;
+        let v = merit_at(&z);
+        if v < best.1 {
+            best = (z, v);
+        }
+        v
+    };
+    let mut center = DVector::zeros(n);
+    let mut step = 0.05;
+    for _restart in 0..6 {
+        let (y, improved) = nelder_mead(&mut f, &center, step, &mut evaluations);
+        center = y;
+        step *= 0.2;
+        if !improved && step < 1e-9 {
+            break;
+        }
+    }
+    best
+}

@@ -11,7 +11,9 @@
 //!   whose anchors all lie inside an anchor's lower norm bound) holds no design;
 //! - **finds designs** in a box from its relaxed point: counterweights projected and refined
 //!   ([`crate::refine`]), springs polished from the relaxed anchors ([`crate::springs`], one
-//!   deterministic start); a design counts only when every bound and peak limit holds;
+//!   deterministic start); a design counts only when every bound and peak limit holds, and a
+//!   new best design that does not close the gap is descended from over the counterweights,
+//!   the springs realized again at each step (module `polish`);
 //! - **splits** the box at the midpoint of the coordinate that carries the largest relaxation
 //!   error (the spring coupling error `|W − αβ/K|` shared by its two anchor components, times
 //!   their relative widths), or, when the springs' error is negligible, of the widest
@@ -31,6 +33,7 @@
 //! last one left ([`SearchState`]).
 
 pub mod node;
+mod polish;
 
 use std::sync::Arc;
 
@@ -188,6 +191,32 @@ fn bound_box(
     }
 }
 
+/// The design at a full lifted point with realized springs, if it meets every bound and peak
+/// limit on the tasks searched (and every counterweight has a positive mass).
+fn verified_design(
+    problem: &VariantProblem,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    springs: Vec<SpringValues>,
+    x_full: DVector<f64>,
+) -> Option<Design> {
+    let cws = problem.cw_physical(&x_full);
+    if cws.iter().any(|c| c.mass.is_nan() || c.mass <= 0.0) {
+        return None;
+    }
+    let e = problem.evaluate(&cws, tasks);
+    let worst = problem
+        .bound_violations(&x_full)
+        .into_iter()
+        .fold(problem.peak_excess(&e), f64::max);
+    (worst <= FEASIBILITY_TOL).then(|| Design {
+        value: e.objective(objective, problem.actuators),
+        x: x_full,
+        cws,
+        springs,
+    })
+}
+
 /// A design from a box's relaxed point, if one meets every bound and limit.
 fn design_at(
     problem: &VariantProblem,
@@ -211,23 +240,7 @@ fn design_at(
         refined.z
     };
     let x = problem.lifted(&z);
-    let accept = |springs: Vec<SpringValues>, x_full: DVector<f64>| -> Option<Design> {
-        let cws = problem.cw_physical(&x_full);
-        if cws.iter().any(|c| c.mass.is_nan() || c.mass <= 0.0) {
-            return None;
-        }
-        let e = problem.evaluate(&cws, tasks);
-        let worst = problem
-            .bound_violations(&x_full)
-            .into_iter()
-            .fold(problem.peak_excess(&e), f64::max);
-        (worst <= FEASIBILITY_TOL).then(|| Design {
-            value: e.objective(objective, problem.actuators),
-            x: x_full,
-            cws,
-            springs,
-        })
-    };
+    let accept = |springs, x_full| verified_design(problem, tasks, objective, springs, x_full);
     let (found, _) = realize_springs(problem, b, &x, 1, false);
     if let Some(d) = found.into_iter().find_map(|(s, xf)| accept(s, xf)) {
         return Some(d);
@@ -548,6 +561,15 @@ pub fn branch_and_bound(
         if let Some(d) = found
             && best.as_ref().is_none_or(|bd| d.value < bd.value)
         {
+            // A design that does not close the gap on its own is descended from before it is
+            // kept (see [`polish`]): the boxes only propose designs near their relaxed points.
+            let d = if closes(lowest, &Some(d.clone())) {
+                d
+            } else {
+                polish::descend(problem, b, tasks, objective, &d, scale)
+                    .filter(|p| p.value < d.value)
+                    .unwrap_or(d)
+            };
             best = Some(d);
         }
         if closes(current.bound, &best) {
