@@ -402,3 +402,32 @@ pub fn minimise_along(
     }
     best
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A quadratic with its minimum on the plane the directions span, a strip where the merit
+    /// is undefined, and a third coordinate the search must not move: by hand the best point is
+    /// `(0.3, −0.2, 0.1)` with merit `0.1² = 0.01`.
+    #[test]
+    fn the_descent_along_directions_reaches_the_hand_minimum_and_returns_its_merit() {
+        let z0 = DVector::from_vec(vec![0.0, 0.0, 0.1]);
+        let directions = DMatrix::from_row_slice(3, 2, &[2.0, 0.0, 0.0, 0.5, 0.0, 0.0]);
+        let merit = |z: &DVector<f64>| {
+            if z[0] > 0.5 {
+                return f64::INFINITY;
+            }
+            (z[0] - 0.3).powi(2) + (z[1] + 0.2).powi(2) + z[2] * z[2]
+        };
+        let (z, value) = minimise_along(&z0, &directions, merit);
+        assert!((z[0] - 0.3).abs() <= 1e-6, "{z}");
+        assert!((z[1] + 0.2).abs() <= 1e-6, "{z}");
+        assert_eq!(z[2], 0.1);
+        assert!((value - 0.01).abs() <= 1e-11, "{value}");
+        assert_eq!(value, merit(&z));
+        // No direction: the start and its merit.
+        let (z, value) = minimise_along(&z0, &DMatrix::zeros(3, 0), merit);
+        assert_eq!((z, value), (z0.clone(), merit(&z0)));
+    }
+}
