@@ -260,17 +260,28 @@ pub fn refine(
         }
         m
     };
+    restarted_nelder_mead(&mut f, n, &mut evaluations);
+    finish(best_feasible, best_any, evaluations)
+}
+
+/// Nelder–Mead from the origin of `n` coordinates, restarted from its best vertex with a simplex
+/// five times smaller (at most six runs) until a run no longer improves: restarts guard
+/// against a simplex that collapsed before the minimum.
+fn restarted_nelder_mead(
+    f: &mut impl FnMut(&DVector<f64>, &mut usize) -> f64,
+    n: usize,
+    evaluations: &mut usize,
+) {
     let mut center = DVector::zeros(n);
     let mut step = 0.05;
     for _restart in 0..6 {
-        let (y, improved) = nelder_mead(&mut f, &center, step, &mut evaluations);
+        let (y, improved) = nelder_mead(f, &center, step, evaluations);
         center = y;
         step *= 0.2;
         if !improved && step < 1e-9 {
             break;
         }
     }
-    finish(best_feasible, best_any, evaluations)
 }
 
 fn finish(
@@ -390,16 +401,7 @@ pub fn minimise_along(
         }
         v
     };
-    let mut center = DVector::zeros(n);
-    let mut step = 0.05;
-    for _restart in 0..6 {
-        let (y, improved) = nelder_mead(&mut f, &center, step, &mut evaluations);
-        center = y;
-        step *= 0.2;
-        if !improved && step < 1e-9 {
-            break;
-        }
-    }
+    restarted_nelder_mead(&mut f, n, &mut evaluations);
     best
 }
 
