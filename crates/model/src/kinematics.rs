@@ -365,7 +365,8 @@ impl Kinematics {
     ) -> Result<(DVector<f64>, DVector<f64>), crate::KinematicsError> {
         let at = self.point(q);
         let g = self.jacobian_at(&at);
-        let lu = crate::newton::checked_lu(&g, q, crate::NewtonOptions::default().max_condition)?;
+        let lu =
+            crate::jacobian_lu::checked_lu(&g, q, crate::NewtonOptions::default().max_condition)?;
         let qd = lu.solve(ud).expect("checked non-singular");
         let qdd = lu
             .solve(&(udd - self.bias_at(&at, &qd)))

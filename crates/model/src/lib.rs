@@ -13,6 +13,8 @@
 pub mod case;
 pub mod error;
 pub mod exact;
+pub mod inertia;
+mod jacobian_lu;
 mod joints;
 pub mod kinematics;
 pub mod limits;

@@ -309,7 +309,7 @@ impl MechanismScale {
                 let k = if b.mass > 0.0 {
                     // The trace bounds the largest moment of a positive semi-definite
                     // tensor: the fallback if the capped eigensolver gives up.
-                    let largest = crate::validate::principal_moments(&b.inertia_com)
+                    let largest = crate::inertia::principal_moments(&b.inertia_com)
                         .map_or(b.inertia_com.trace(), |e| {
                             e.iter().fold(0.0f64, |m, x| m.max(*x))
                         });
