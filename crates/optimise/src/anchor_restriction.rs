@@ -13,7 +13,7 @@
 use counterpoise_dynamics::linalg::checked_svd;
 use nalgebra::{DMatrix, DVector};
 
-use crate::problem::SpringSlot;
+use crate::slots::SpringSlot;
 
 /// Relative tolerance of "row `α_i` is `c` times row `K`" on the family `x_p + N z` (the family
 /// comes from exact arithmetic rounded to doubles, so proportional rows agree to ~1e-15).

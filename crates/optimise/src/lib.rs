@@ -34,6 +34,7 @@ pub mod progress;
 pub mod refine;
 pub mod relaxation;
 pub mod result;
+pub mod slots;
 pub mod springs;
 pub mod timing;
 pub mod torque;

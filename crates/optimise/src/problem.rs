@@ -10,13 +10,14 @@
 //! `π = (m, m r, I_o)` the dynamics crate builds — and the task torques of [`crate::torque`].
 
 use counterpoise_balance::linear::LinearSolution;
-use counterpoise_balance::{Attachment, Catalogue, Element};
+use counterpoise_balance::{Catalogue, Element};
 use counterpoise_dynamics::params::{BODY_PARAMS, counterweight_inertia};
 use counterpoise_model::Model;
 use nalgebra::{DMatrix, DVector, Matrix3};
 use serde::{Deserialize, Serialize};
 
-use crate::overrides::{BoundsTable, CounterweightBounds, SpringBounds};
+use crate::overrides::BoundsTable;
+pub use crate::slots::{CwPhysical, CwSlot, MIN_MASS_FRACTION, SpringSlot, norm};
 use crate::torque::TaskTorques;
 
 /// What is minimised.
@@ -29,54 +30,6 @@ pub enum Objective {
     RmsStar,
     /// QTR (Eq. 1): the largest sum over actuators of the per-task RMS torque, over all tasks.
     Minimax,
-}
-
-/// Smallest counterweight mass treated as installed, relative to the upper mass bound: a mass
-/// that must vanish means the variant is really a smaller one.
-pub const MIN_MASS_FRACTION: f64 = 1e-6;
-
-/// A counterweight of the variant.
-#[derive(Clone, Debug)]
-pub struct CwSlot {
-    pub entry: usize,
-    pub label: String,
-    pub body: usize,
-    /// Body-frame axes of `r`.
-    pub axes: Vec<usize>,
-    /// First lifted variable (`m`) in `x`.
-    pub column: usize,
-    /// Slot of the body in the torque cache.
-    pub torque_slot: usize,
-    pub bounds: CounterweightBounds,
-    /// Centroidal inertia of a 1 kg counterweight (`J(m) = m^{5/3} J1`).
-    pub j1: Matrix3<f64>,
-}
-
-impl CwSlot {
-    pub fn min_mass(&self) -> f64 {
-        self.bounds.mass[0].max(MIN_MASS_FRACTION * self.bounds.mass[1].max(1.0))
-    }
-}
-
-/// A spring of the variant.
-#[derive(Clone, Debug)]
-pub struct SpringSlot {
-    pub entry: usize,
-    pub label: String,
-    pub body: usize,
-    pub other: Attachment,
-    pub axes_a: Vec<usize>,
-    pub axes_b: Vec<usize>,
-    pub column: usize,
-    pub bounds: SpringBounds,
-}
-
-impl SpringSlot {
-    /// Number of lifted variables.
-    pub fn lifted_len(&self) -> usize {
-        let (na, nb) = (self.axes_a.len(), self.axes_b.len());
-        1 + na + nb + na * nb
-    }
 }
 
 /// A variant's balanced family with its elements and bounds.
@@ -97,25 +50,6 @@ pub struct VariantProblem {
 }
 
 /// Physical counterweight parameters derived from a lifted point.
-#[derive(Clone, Copy, Debug)]
-pub struct CwPhysical {
-    pub mass: f64,
-    pub mu: [f64; 3],
-}
-
-impl CwPhysical {
-    pub fn offset(&self) -> [f64; 3] {
-        self.mu.map(|v| v / self.mass)
-    }
-    pub fn radius(&self) -> f64 {
-        norm(&self.mu) / self.mass
-    }
-}
-
-pub fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
-}
-
 /// Torque statistics of a point on a set of tasks.
 #[derive(Clone, Debug)]
 pub struct Evaluation {
