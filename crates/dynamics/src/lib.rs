@@ -10,9 +10,11 @@
 // the hot-loop entry points take their buffers explicitly rather than bundled.
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
+mod coefficient_sweeps;
 pub mod compiled;
 pub mod error;
 pub mod evaluate;
+pub mod evaluate_options;
 pub mod fast;
 pub mod indicators;
 pub mod kernel;
@@ -23,10 +25,12 @@ pub mod mechanism;
 pub mod params;
 pub mod paths;
 pub mod progress;
+mod reaction_kernels;
 pub mod reactions;
 pub mod regressor;
 pub mod runner;
 mod simd;
+mod superposition;
 pub mod symmetry;
 pub mod tasks;
 

@@ -1,0 +1,46 @@
+//! The options of an evaluation: samples, reactions, the cyclic shortcut, and how a batch's
+//! columns are combined.
+//!
+//! Both the direct evaluation (`evaluate`) and the cyclic one (`fast`) read them; they sit
+//! apart so that neither of those modules depends on the other for them.
+
+/// Options of [`crate::evaluate::evaluate`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EvaluateOptions {
+    /// Samples per task (default: the case's).
+    pub samples: Option<usize>,
+    /// Compute joint reactions (`F_j`, `M_j`).
+    pub reactions: bool,
+    /// Use the cyclic-coordinate decomposition ([`crate::symmetry`], `fast` module) when the
+    /// model has a cyclic coordinate; `false` runs every task directly (the reference path).
+    pub shortcut: bool,
+}
+
+impl Default for EvaluateOptions {
+    fn default() -> Self {
+        EvaluateOptions {
+            samples: None,
+            reactions: true,
+            shortcut: true,
+        }
+    }
+}
+
+/// How the outputs of a batch's columns are computed by the grid evaluation.
+///
+/// Both give the same values to rounding (the root package's `tests/superposition.rs`: the
+/// palletizer's joint reaction peaks to 1e-9 relative); each is deterministic per column,
+/// whatever else is in the batch. A study uses one of them throughout, so that its shards
+/// merge into the single run's bits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Combination {
+    /// Every column through the reaction solve of its own right-hand side (and its inertia
+    /// group's changes with the rotation speed).
+    #[default]
+    Direct,
+    /// The model's own parameters and one unit column per lifted row that any column changes
+    /// are solved; each column is the model's outputs plus its elements' rows times their unit
+    /// outputs, its own rows in ascending order. Cheaper once the batch has more columns than
+    /// rows (Dmax 3 and up), and the way to evaluate one variant's many spring options.
+    Superposition,
+}
