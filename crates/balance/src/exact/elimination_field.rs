@@ -2,9 +2,9 @@
 //! (ℚ(√2, √3)). Every pivot row is divided by its pivot, so the reduced rows are unique (the
 //! reduced row-echelon form) and rank, consistency and the solution set are facts of the field.
 
-use counterpoise_symbolic::RefArith;
+use counterpoise_symbolic::{Rational, RefArith, Surd};
 
-use super::elimination::Echelon;
+use super::field::Echelon;
 use super::field::ExactField;
 
 /// Eliminates `[A | r]`, given as rows of `columns + 1` field elements.
@@ -51,6 +51,40 @@ where
         rows,
         pivots,
         consistent,
+    }
+}
+
+/// ℚ(√2, √3): entries are field elements, eliminated with exact division (above).
+impl ExactField for Surd {
+    type Entry = Surd;
+    fn entry_is_zero(e: &Surd) -> bool {
+        counterpoise_symbolic::Scalar::is_zero(e)
+    }
+    fn zero_entry() -> Surd {
+        Surd::default()
+    }
+    fn neg_entry(e: &Surd) -> Surd {
+        -e
+    }
+    fn entry_value(e: &Surd) -> Surd {
+        e.clone()
+    }
+    fn ratio(a: &Surd, p: &Surd) -> Surd {
+        a / p
+    }
+    /// No scaling: the factors are 1 (the elimination divides anyway).
+    fn scale_rows(
+        b: Vec<Surd>,
+        columns: Vec<Vec<Vec<Surd>>>,
+    ) -> (Vec<Surd>, Vec<Vec<Vec<Surd>>>, Vec<Surd>) {
+        let factors = vec![Surd::from_rational(Rational::from_integer(1.into())); b.len()];
+        (b, columns, factors)
+    }
+    fn equation_row(e: &[Surd]) -> Vec<Surd> {
+        e.to_vec()
+    }
+    fn eliminate(rows: Vec<Vec<Surd>>, columns: usize) -> Echelon<Surd> {
+        gauss_jordan(rows, columns)
     }
 }
 

@@ -9,13 +9,7 @@
 
 use std::fmt::Debug;
 
-use num_bigint::BigInt;
-use num_integer::Integer;
-use num_traits::Zero;
-
-use counterpoise_symbolic::{Ordered, Rational, Surd};
-
-use super::elimination::{Echelon, eliminate};
+use counterpoise_symbolic::{Ordered, Rational};
 
 /// An exact ordered field with its basis storage and elimination.
 pub trait ExactField: Ordered {
@@ -41,98 +35,76 @@ pub trait ExactField: Ordered {
     fn eliminate(rows: Vec<Vec<Self::Entry>>, columns: usize) -> Echelon<Self>;
 }
 
-impl ExactField for Rational {
-    type Entry = BigInt;
-    fn entry_is_zero(e: &BigInt) -> bool {
-        e.is_zero()
-    }
-    fn zero_entry() -> BigInt {
-        BigInt::zero()
-    }
-    fn neg_entry(e: &BigInt) -> BigInt {
-        -e
-    }
-    fn entry_value(e: &BigInt) -> Rational {
-        Rational::from_integer(e.clone())
-    }
-    fn ratio(a: &BigInt, p: &BigInt) -> Rational {
-        Rational::new(a.clone(), p.clone())
-    }
-    fn scale_rows(
-        b: Vec<Rational>,
-        columns: Vec<Vec<Vec<Rational>>>,
-    ) -> (Vec<BigInt>, Vec<Vec<Vec<BigInt>>>, Vec<Rational>) {
-        let rows = b.len();
-        // One positive factor per row: the lcm of its denominators over the gcd of its
-        // numerators.
-        let mut factors = Vec::with_capacity(rows);
-        for r in 0..rows {
-            let entries = std::iter::once(&b[r]).chain(columns.iter().flatten().map(|c| &c[r]));
-            let (mut lcm, mut gcd) = (BigInt::from(1), BigInt::zero());
-            for q in entries.filter(|q| !q.is_zero()) {
-                lcm = lcm.lcm(q.denom());
-                gcd = gcd.gcd(q.numer());
-            }
-            let gcd = if gcd.is_zero() { BigInt::from(1) } else { gcd };
-            factors.push(Rational::new(lcm, gcd));
-        }
-        let scale = |v: &[Rational]| -> Vec<BigInt> {
-            v.iter()
-                .zip(&factors)
-                .map(|(q, f)| {
-                    let s = q * f;
-                    debug_assert!(s.is_integer());
-                    s.to_integer()
-                })
-                .collect()
-        };
-        let scaled_b = scale(&b);
-        let scaled = columns
-            .iter()
-            .map(|entry| entry.iter().map(|c| scale(c)).collect())
-            .collect();
-        (scaled_b, scaled, factors)
-    }
-    fn equation_row(e: &[Rational]) -> Vec<BigInt> {
-        let lcm = e.iter().fold(BigInt::from(1), |acc, q| acc.lcm(q.denom()));
-        e.iter()
-            .map(|q| (q * Rational::from_integer(lcm.clone())).to_integer())
-            .collect()
-    }
-    fn eliminate(rows: Vec<Vec<BigInt>>, columns: usize) -> Echelon<Rational> {
-        eliminate(&rows, columns)
-    }
+/// One solved row: `(pivot column, [(free column, coefficient)], value)`, meaning
+/// `x_pivot + Σ coefficient·x_free = value`.
+pub type Relation<F = Rational> = (usize, Vec<(usize, F)>, F);
+
+/// The echelon form of `[A | r]` after Gauss–Jordan elimination, over the field `F` (rows of
+/// integers over ℚ, of field elements otherwise).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Echelon<F: ExactField = Rational> {
+    /// Number of unknowns (columns of `A`).
+    pub columns: usize,
+    /// Non-zero rows: entries for columns `0..columns`, then the right-hand side.
+    pub(super) rows: Vec<Vec<F::Entry>>,
+    /// Pivot column of each row (strictly increasing).
+    pub pivots: Vec<usize>,
+    /// Whether `A x = r` has a solution (no row `0 = c ≠ 0`).
+    pub consistent: bool,
 }
 
-impl ExactField for Surd {
-    type Entry = Surd;
-    fn entry_is_zero(e: &Surd) -> bool {
-        counterpoise_symbolic::Scalar::is_zero(e)
+impl<F: ExactField> Echelon<F> {
+    /// Rank of `A`.
+    pub fn rank(&self) -> usize {
+        self.pivots.len()
     }
-    fn zero_entry() -> Surd {
-        Surd::default()
+
+    /// Columns that are not pivots: one free direction each.
+    pub fn free_columns(&self) -> Vec<usize> {
+        (0..self.columns)
+            .filter(|c| !self.pivots.contains(c))
+            .collect()
     }
-    fn neg_entry(e: &Surd) -> Surd {
-        -e
+
+    /// The solution with every free variable zero (only meaningful when consistent).
+    pub fn particular(&self) -> Vec<F> {
+        let mut x = vec![F::zero(); self.columns];
+        for (row, &c) in self.rows.iter().zip(&self.pivots) {
+            x[c] = F::ratio(&row[self.columns], &row[c]);
+        }
+        x
     }
-    fn entry_value(e: &Surd) -> Surd {
-        e.clone()
+
+    /// Each row as `x_pivot + Σ coefficient·x_j = value` (coefficients of the free columns).
+    pub fn relations(&self) -> Vec<Relation<F>> {
+        self.rows
+            .iter()
+            .zip(&self.pivots)
+            .map(|(row, &p)| {
+                let terms = (0..self.columns)
+                    .filter(|&j| j != p && !F::entry_is_zero(&row[j]))
+                    .map(|j| (j, F::ratio(&row[j], &row[p])))
+                    .collect();
+                (p, terms, F::ratio(&row[self.columns], &row[p]))
+            })
+            .collect()
     }
-    fn ratio(a: &Surd, p: &Surd) -> Surd {
-        a / p
-    }
-    /// No scaling: the factors are 1 (the elimination divides anyway).
-    fn scale_rows(
-        b: Vec<Surd>,
-        columns: Vec<Vec<Vec<Surd>>>,
-    ) -> (Vec<Surd>, Vec<Vec<Vec<Surd>>>, Vec<Surd>) {
-        let factors = vec![Surd::from_rational(Rational::from_integer(1.into())); b.len()];
-        (b, columns, factors)
-    }
-    fn equation_row(e: &[Surd]) -> Vec<Surd> {
-        e.to_vec()
-    }
-    fn eliminate(rows: Vec<Vec<Surd>>, columns: usize) -> Echelon<Surd> {
-        super::elimination_field::gauss_jordan(rows, columns)
+
+    /// A basis of the null space of `A`: for each free column `f`, `x_f = 1`, other free
+    /// variables zero, pivots solved.
+    pub fn nullspace(&self) -> Vec<Vec<F>> {
+        self.free_columns()
+            .into_iter()
+            .map(|f| {
+                let mut v = vec![F::zero(); self.columns];
+                v[f] = F::one();
+                for (row, &c) in self.rows.iter().zip(&self.pivots) {
+                    if !F::entry_is_zero(&row[f]) {
+                        v[c] = F::ratio(&F::neg_entry(&row[f]), &row[c]);
+                    }
+                }
+                v
+            })
+            .collect()
     }
 }

@@ -23,6 +23,7 @@ pub mod elimination_field;
 pub mod field;
 pub mod positivity;
 pub mod rank_one;
+mod rational_field;
 pub mod split;
 
 use std::collections::BTreeMap;
