@@ -26,6 +26,7 @@ pub mod exact;
 pub mod linear;
 pub mod minimal;
 pub mod model_input;
+pub mod number_text;
 pub mod partial;
 pub mod realize;
 pub mod relations;

@@ -12,6 +12,8 @@ use crate::exact::positivity::{self, Bound};
 use crate::exact::{ExactField, ExactSolution, exact_text};
 use crate::linear::{FIXED_TOL, LinearSolution};
 
+pub use crate::number_text::significant;
+
 /// One free direction of the balanced family: moving along it keeps the energy constant.
 #[derive(Clone, Debug, Serialize)]
 pub struct FreeDirection {
@@ -42,25 +44,6 @@ pub fn variable_units(entry: &CatalogueEntry) -> Vec<&'static str> {
             .chain(std::iter::repeat_n("N·m", axes_a.len() * axes_b.len()))
             .collect(),
     }
-}
-
-/// A value with six significant digits, without trailing zeros: `228.625`, `1.23457e-7`.
-pub fn significant(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let magnitude = x.abs().log10().floor();
-    if !(-4.0..6.0).contains(&magnitude) {
-        return format!("{x:.5e}");
-    }
-    let decimals = (5.0 - magnitude).max(0.0) as usize;
-    let s = format!("{x:.decimals$}");
-    let s = if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    };
-    if s == "-0" { "0".to_string() } else { s }
 }
 
 fn format_number(x: f64) -> String {

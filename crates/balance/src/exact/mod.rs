@@ -297,7 +297,7 @@ pub fn exact_text<F: ExactField>(x: &F) -> String {
     let Some(q) = x.rational() else {
         return format!(
             "{x} ({})",
-            crate::relations::significant(counterpoise_symbolic::Scalar::to_f64(x))
+            crate::number_text::significant(counterpoise_symbolic::Scalar::to_f64(x))
         );
     };
     if q.is_integer() {
@@ -307,7 +307,7 @@ pub fn exact_text<F: ExactField>(x: &F) -> String {
             "{}/{} ({})",
             q.numer(),
             q.denom(),
-            crate::relations::significant(counterpoise_symbolic::rational_to_f64(&q))
+            crate::number_text::significant(counterpoise_symbolic::rational_to_f64(&q))
         )
     }
 }
