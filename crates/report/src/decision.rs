@@ -32,10 +32,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::format::{mass, percent};
 use crate::ranking::Class;
-use crate::results::VariantRecord;
+use crate::variant::VariantRecord;
 
-/// Default tolerance of the equivalence, percentage points.
-pub const DEFAULT_TOLERANCE: f64 = 0.5;
+pub use crate::ranking::DEFAULT_TOLERANCE;
 /// Added masses closer than this share of the moving mass are equal (step 1), percent.
 pub const MASS_MARGIN_PERCENT: f64 = 1.0;
 /// Added-mass margin when the moving mass is unknown, kg.

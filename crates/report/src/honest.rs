@@ -27,8 +27,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::parameters::{ElementKind, PhysicalParameters};
 use crate::practical::PracticalFigures;
-use crate::results::{ElementKind, PhysicalParameters, VariantRecord};
+use crate::variant::VariantRecord;
 
 /// An element whose largest force is below this fraction of the moving mass's weight idles.
 pub const IDLE_FRACTION: f64 = 1e-3;

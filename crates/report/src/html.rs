@@ -494,7 +494,7 @@ fn push_schematics(h: &mut String, r: &RunResults, heading: &str) {
         if s.variant.is_some() && v.is_none() {
             continue;
         }
-        let _ = write!(h, "<figure>{}</figure>", crate::schematic::svg(r, v, s));
+        let _ = write!(h, "<figure>{}</figure>", crate::schematic_svg::svg(r, v, s));
     }
     h.push_str("</div><p class=\"note\">Bodies (grey bars from the joint each hangs from to its other joints and its centre of mass, a dot), joints (open circles, hatched where on the base), counterweights (blue discs at their centre of mass, area growing with the mass: the volume of a disc of the same material), springs (green zig-zags between their anchors, dashed to the joint of the body each anchor is on). Drawn from the model's kinematics, orthographic, in the vertical plane the mechanism spreads in most; up is against gravity.</p>");
 }
@@ -622,11 +622,11 @@ fn push_partial(h: &mut String, p: &PartialBalancing) {
     for paragraph in partial::paragraphs(p) {
         let _ = write!(h, "<p class=\"note\">{}</p>", esc(&paragraph));
     }
-    if let Some(svg) = partial::chart(p) {
+    if let Some(svg) = crate::partial_view::chart(p) {
         let _ = write!(h, "<div class=\"charts\"><figure>{svg}</figure></div>");
     }
     if !p.designs.is_empty() {
-        h.push_str(&table(&partial::table(p), "partial"));
+        h.push_str(&table(&crate::partial_view::table(p), "partial"));
     }
 }
 

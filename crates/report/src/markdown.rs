@@ -51,7 +51,7 @@ pub fn render(r: &RunResults) -> String {
             let _ = writeln!(s, "{}\n", esc(&paragraph));
         }
         if !p.designs.is_empty() {
-            table(&mut s, &crate::partial::table(p));
+            table(&mut s, &crate::partial_view::table(p));
             s.push_str("The chart of the RMS per actuator is in report.html.\n\n");
         }
     }

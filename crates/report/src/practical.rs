@@ -10,7 +10,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::results::PhysicalParameters;
+use crate::parameters::PhysicalParameters;
 
 /// Peak stretch and force of one spring over the configurations the caller checked.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -37,6 +37,9 @@ use std::cmp::Ordering;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+/// Default tolerance of the equivalence, percentage points.
+pub const DEFAULT_TOLERANCE: f64 = 0.5;
+
 /// The paper's three classes of balanced variants.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -81,7 +84,7 @@ pub struct RankingOptions {
 }
 
 fn default_tolerance() -> f64 {
-    crate::decision::DEFAULT_TOLERANCE
+    DEFAULT_TOLERANCE
 }
 
 impl Default for RankingOptions {

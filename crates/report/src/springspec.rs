@@ -30,8 +30,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::parameters::SpringParams;
 use crate::practical::SpringPeak;
-use crate::results::{SpringParams, VariantRecord};
+use crate::variant::VariantRecord;
 
 /// Largest initial tension assumed achievable, as a share of the peak force.
 pub const MAX_INITIAL_TENSION_SHARE: f64 = 0.25;

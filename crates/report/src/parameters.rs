@@ -1,0 +1,96 @@
+//! The physical parameters of a variant's elements as the results document records them:
+//! which element, where it sits, its mass or stiffness and anchors (SI units).
+//!
+//! The practical figures, the spring specifications and the variant records all read these;
+//! they sit on the ground floor of the crate, with no dependence on what reads them.
+
+use serde::{Deserialize, Serialize};
+
+/// Plane in which a counterweight offset or spring anchor lies, for polar display (Table 1);
+/// the same names as the case file's `plane`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Plane {
+    Xy,
+    Yz,
+    Xz,
+}
+
+impl Plane {
+    /// Indices of the (first, second) axes: the angle is atan2(second, first).
+    pub fn axes(self) -> (usize, usize) {
+        match self {
+            Plane::Xy => (0, 1),
+            Plane::Yz => (1, 2),
+            Plane::Xz => (0, 2),
+        }
+    }
+}
+
+/// `counterweight` or `spring`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ElementKind {
+    Counterweight,
+    Spring,
+}
+
+/// One installed element of a variant.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ElementInfo {
+    /// Catalogue label, e.g. `m4` or `K43`.
+    pub label: String,
+    #[serde(rename = "type")]
+    pub kind: ElementKind,
+    /// Body names: one for a counterweight, two for a spring (`base` for the ground).
+    pub bodies: Vec<String>,
+}
+
+/// Physical parameters of a counterweight.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CounterweightParams {
+    pub label: String,
+    pub body: String,
+    /// kg.
+    pub mass: f64,
+    /// Centre of mass in the body frame, m.
+    pub offset: [f64; 3],
+    /// Plane of the offset, when the case restricts it to one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane: Option<Plane>,
+}
+
+/// Physical parameters of a zero-free-length spring.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpringParams {
+    pub label: String,
+    /// Body carrying anchor `a`.
+    pub body: String,
+    /// Body carrying anchor `b` (`base` for the ground).
+    pub other: String,
+    /// N/m.
+    pub stiffness: f64,
+    /// Anchor on `body`, in its frame, m.
+    pub anchor_a: [f64; 3],
+    /// Anchor on `other`, in its frame, m.
+    pub anchor_b: [f64; 3],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane: Option<Plane>,
+}
+
+/// The physical parameters of a variant.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PhysicalParameters {
+    pub counterweights: Vec<CounterweightParams>,
+    pub springs: Vec<SpringParams>,
+}
+
+/// One free direction of the balanced family (lifted variable → component).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FreeDirection {
+    pub components: Vec<(String, f64)>,
+    /// Interval of the step along the direction keeping masses and stiffnesses positive
+    /// (`None` bound = unbounded on that side).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub positive_interval: Option<(Option<f64>, Option<f64>)>,
+}
