@@ -4,12 +4,16 @@
 //! free coordinates, and from a second evaluation of the joint reactions through the dynamics
 //! crate's grid tables.
 
+use super::peaks::{batched_reaction_peaks, reaction_peaks};
 use super::*;
+use crate::result::{FreeParameter, OptimisedStatus};
 use crate::springs::realize_springs;
 use crate::torque::TaskTorques;
 use counterpoise_balance::{Catalogue, SearchOptions, catalogue_options, mechanism_energy};
 use counterpoise_balance::{realization_hints, search};
 use counterpoise_dynamics::evaluate_grid;
+use counterpoise_dynamics::params::{Counterweight, ParameterSet, Spring, Variant};
+use counterpoise_dynamics::{EvaluateOptions, Indicators};
 use counterpoise_model::{Case, Model};
 use std::sync::Arc;
 

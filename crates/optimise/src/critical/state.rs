@@ -1,0 +1,140 @@
+//! What the critical-task loop carries per variant: its options, each variant's run (working
+//! set, passes, state, candidate) and the stages' timings.
+
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+
+use crate::certify::SearchState;
+use crate::problem::{CwPhysical, Objective, VariantProblem};
+use crate::result::Iteration;
+use crate::springs::{SpringValues, StartRecord};
+use crate::timing::StageTime;
+
+/// Settings of the optimisation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OptimiseOptions {
+    pub objective: Objective,
+    /// Most passes of the critical-task loop.
+    pub max_iterations: usize,
+    /// Relative gap below which the relaxation's recovered point is accepted without local
+    /// refinement.
+    pub gap_tolerance: f64,
+    /// Starts of the spring realization per pass (the final choice uses four times as many).
+    pub spring_starts: usize,
+    /// Compute joint reactions in the final all-task evaluation (F_j, M_j, ΔR).
+    pub final_reactions: bool,
+    /// clarabel iteration limit.
+    pub solver_iterations: u32,
+    /// Boxes the certified search ([`crate::certify`]) solves at most per variant and pass: the
+    /// only limit that can leave a variant undecided.
+    #[serde(default = "default_max_nodes")]
+    pub max_nodes: usize,
+    /// Seed of the local search's starting points after the first. Verdicts, optima (within
+    /// the gap tolerance) and ranks do not depend on it.
+    #[serde(default = "default_start_seed")]
+    pub start_seed: u64,
+}
+
+pub(super) fn default_start_seed() -> u64 {
+    crate::springs::DEFAULT_SEED
+}
+
+pub(super) fn default_max_nodes() -> usize {
+    OptimiseOptions::default().max_nodes
+}
+
+impl Default for OptimiseOptions {
+    fn default() -> Self {
+        OptimiseOptions {
+            objective: Objective::RmsStar,
+            max_iterations: 8,
+            gap_tolerance: 1e-3,
+            spring_starts: 8,
+            final_reactions: true,
+            solver_iterations: 200,
+            max_nodes: crate::certify::DEFAULT_MAX_NODES,
+            start_seed: crate::springs::DEFAULT_SEED,
+        }
+    }
+}
+
+/// A variant in the loop.
+#[derive(Clone)]
+pub(super) struct Run {
+    pub(super) elements: Vec<String>,
+    pub(super) class: counterpoise_balance::Class,
+    pub(super) problem: Option<VariantProblem>,
+    pub(super) working: Vec<usize>,
+    pub(super) iterations: Vec<Iteration>,
+    pub(super) state: State,
+    pub(super) candidate: Option<Candidate>,
+    /// What the last branch-and-bound left (its next pass starts from these boxes).
+    pub(super) search: Option<SearchState>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum State {
+    Running,
+    Converged,
+    Stopped,
+    /// Proved impossible (the reason names the binding constraint).
+    Discarded(String),
+    /// Not built, not proved impossible.
+    Undecided(String),
+}
+
+/// Why a pass produced no candidate.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum Failure {
+    Discard(String),
+    Undecided(String),
+}
+
+impl Failure {
+    pub(super) fn into_state(self) -> State {
+        match self {
+            Failure::Discard(r) => State::Discarded(r),
+            Failure::Undecided(r) => State::Undecided(r),
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub(super) struct Candidate {
+    pub(super) x: DVector<f64>,
+    pub(super) cws: Vec<CwPhysical>,
+    pub(super) springs: Vec<SpringValues>,
+    /// 0 (the trivial bound) when the relaxation was not solved.
+    pub(super) lower_bound: f64,
+    /// Whether `lower_bound` is the relaxation's certified bound.
+    pub(super) bound_certified: bool,
+    pub(super) working_value: f64,
+    pub(super) relaxation_status: crate::clarabel_map::ConicStatus,
+    pub(super) relaxation_iterations: u32,
+    pub(super) gap_before: f64,
+    /// The spring realization's local solves for these counterweights (the spring choice
+    /// reuses them).
+    pub(super) spring_starts: Option<StartRecord>,
+    /// Boxes the certified search solved (0 when the fast path was within the tolerance).
+    pub(super) boxes: usize,
+}
+
+/// Wall and CPU time of the stages of [`optimise_all`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct StageTimings {
+    /// Relaxations, refinements and spring realizations of every pass.
+    pub solve: StageTime,
+    /// The all-task torque evaluations of the critical-task loop.
+    pub loop_grid: StageTime,
+    /// Spring choice by ΔR on the reaction tasks.
+    pub spring_choice: StageTime,
+    /// Of the spring choice, the joint reactions of the options on the reaction tasks (the
+    /// rest is the realization of the options).
+    pub spring_reactions: StageTime,
+    /// Final all-task evaluation (torques and joint reactions).
+    pub final_grid: StageTime,
+    /// Verification and records.
+    pub records: StageTime,
+    /// Passes of the critical-task loop.
+    pub passes: usize,
+}

@@ -1,0 +1,126 @@
+use super::*;
+use counterpoise_model::sampling::SplitMix64;
+
+/// The lazily constrained solve against the same problem with every row from the start:
+/// minimise `u ≥ ‖x − (3, −2)‖` subject to 200 random rows `|c·x + d| ≤ 1`, a few of them
+/// binding. Both give the same optimum, and the lazy solution meets every row.
+#[test]
+fn lazy_peak_rows_reach_the_full_problems_optimum() {
+    let mut rng = SplitMix64::new(11);
+    let mut uniform = || 2.0 * rng.next_f64() - 1.0;
+    let rows: Vec<Affine> = (0..200)
+        .map(|_| {
+            let mut e = Affine::constant(0.2 * uniform());
+            e.add_var(0, 0.4 * uniform());
+            e.add_var(1, 0.4 * uniform());
+            e
+        })
+        .collect();
+    let build = || {
+        let mut cp = ConicProblem::default();
+        let x0 = cp.new_variable();
+        let x1 = cp.new_variable();
+        let u = cp.new_variable();
+        cp.objective[u] = 1.0;
+        let mut d0 = Affine::var(x0);
+        d0.constant -= 3.0;
+        let mut d1 = Affine::var(x1);
+        d1.constant += 2.0;
+        cp.soc(&Affine::var(u), &[d0, d1]);
+        cp
+    };
+    let mut full = build();
+    for e in &rows {
+        add_peak_row(&mut full, e);
+    }
+    let reference = full.solve(200);
+    assert_eq!(reference.status, ConicStatus::Solved);
+    let mut lazy = build();
+    let mut added = vec![false; rows.len()];
+    let solution = solve_with_peaks_from(&mut lazy, &rows, &mut added, 200);
+    // Starting from the rows that solve used gives the same optimum in one round.
+    let mut again = build();
+    let mut reused = added.clone();
+    let first = solve_with_peaks_from(&mut again, &rows, &mut reused, 200);
+    assert_eq!(reused, added, "no row beyond the first solve's");
+    assert!((first.objective - solution.objective).abs() <= 1e-6 * solution.objective.abs());
+    assert_eq!(solution.status, ConicStatus::Solved);
+    // The target (3, −2) is outside the feasible set: some row binds.
+    assert!(reference.objective > 1e-3);
+    assert!(
+        (solution.objective - reference.objective).abs() <= 1e-6 * reference.objective,
+        "{} vs {}",
+        solution.objective,
+        reference.objective
+    );
+    for e in &rows {
+        assert!(e.eval(&solution.x).abs() <= 1.0 + 1e-7);
+    }
+}
+
+/// `rms_tail` against the sample-by-sample norm it replaces: for random feature values the
+/// norm of the compressed rows equals `w·‖τ‖` over the samples, τ computed directly from
+/// the base torque and the sensitivities.
+#[test]
+fn compressed_rms_tail_has_the_norm_of_the_sampled_torque() {
+    let (samples, actuators, slots) = (51, 3, 1);
+    let mut rng = SplitMix64::new(7);
+    let mut uniform = || 2.0 * rng.next_f64() - 1.0;
+    let base: Vec<f64> = (0..samples * actuators).map(|_| 30.0 * uniform()).collect();
+    let sensitivity: Vec<Vec<f64>> = (0..slots * BODY_PARAMS)
+        .map(|_| (0..samples * actuators).map(|_| uniform()).collect())
+        .collect();
+    let task = TaskTorques {
+        task: 0,
+        samples,
+        actuators,
+        base,
+        sensitivity,
+    };
+    // Three features over two conic variables: m, μ_x (parts on π 0 and 1) and a mixed one.
+    let features = vec![
+        Feature {
+            expr: Affine::var(0).scaled(100.0),
+            parts: vec![(0, 0, 1.0)],
+        },
+        Feature {
+            expr: Affine::var(1).scaled(20.0),
+            parts: vec![(0, 1, 1.0)],
+        },
+        Feature {
+            expr: {
+                let mut e = Affine::var(0);
+                e.add_var(1, -0.5);
+                e.constant = 0.3;
+                e
+            },
+            parts: vec![(0, 4, 1.0), (0, 7, -2.0)],
+        },
+    ];
+    let w = 0.37;
+    for a in 0..actuators {
+        let tail = rms_tail(&task, a, w, &features);
+        assert_eq!(tail.len(), 1 + features.len());
+        for _ in 0..5 {
+            let x = [uniform(), uniform()];
+            let f: Vec<f64> = features.iter().map(|f| f.expr.eval(&x)).collect();
+            let direct: f64 = (0..samples)
+                .map(|s| {
+                    let mut tau = task.base[s * actuators + a];
+                    for (k, feat) in features.iter().enumerate() {
+                        for &(slot, j, c) in &feat.parts {
+                            tau += f[k] * c * task.sens(slot, j)[s * actuators + a];
+                        }
+                    }
+                    (w * tau).powi(2)
+                })
+                .sum::<f64>()
+                .sqrt();
+            let compressed = tail.iter().map(|e| e.eval(&x).powi(2)).sum::<f64>().sqrt();
+            assert!(
+                (compressed - direct).abs() <= 1e-12 * direct,
+                "{compressed} vs {direct}"
+            );
+        }
+    }
+}
