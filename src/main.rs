@@ -272,14 +272,14 @@ fn run(cli: Cli) -> ExitCode {
         }
     }
     let result = match cli.command {
-        Command::Check { case, .. } => commands::check::run(&case),
+        Command::Check { case, .. } => Ok(commands::text::check(&case)),
         Command::Variants {
             case,
             dmax,
             json,
             minimal,
             ..
-        } => commands::variants::run(&case, dmax, json, minimal),
+        } => Ok(commands::text::variants(&case, dmax, json, minimal)),
         Command::Partial {
             case,
             budget,
@@ -289,9 +289,9 @@ fn run(cli: Cli) -> ExitCode {
             json,
             counterweights_only,
             ..
-        } => commands::partial::run(
+        } => Ok(commands::text::partial(
             &case,
-            commands::partial::Options {
+            counterpoise_study::partial::Options {
                 budget,
                 joints,
                 points,
@@ -299,12 +299,12 @@ fn run(cli: Cli) -> ExitCode {
                 json,
                 springs: !counterweights_only,
             },
-        ),
+        )),
         Command::Evaluate {
             case,
             states: Some(states),
             ..
-        } => commands::states::run(&case, &states),
+        } => Ok(commands::text::states(&case, &states)),
         Command::Evaluate {
             case,
             json,
@@ -314,15 +314,15 @@ fn run(cli: Cli) -> ExitCode {
             series,
             states: None,
             ..
-        } => commands::evaluate::run(
+        } => Ok(commands::text::evaluate(
             &case,
-            commands::evaluate::Options {
+            counterpoise_study::evaluate::Options {
                 json,
                 samples,
                 no_reactions,
-                series: task.zip(series.as_deref()),
             },
-        ),
+            task.zip(series.as_deref()),
+        )),
         Command::Run {
             case,
             dmax,
@@ -343,15 +343,17 @@ fn run(cli: Cli) -> ExitCode {
                 out,
                 jobs: rayon::current_num_threads(),
                 minimax,
-                resolution,
-                tolerance,
+                ranking: counterpoise_report::RankingOptions {
+                    resolution,
+                    tolerance,
+                },
                 // a shard stops after the optimisation: three phases
                 progress: commands::progress::Progress::detect(
                     quiet,
                     if shard.is_some() { 3 } else { 4 },
                 ),
                 shard,
-                search: commands::run::SearchSettings {
+                search: counterpoise_study::SearchSettings {
                     gap,
                     max_nodes: max_nodes as usize,
                     seed,
@@ -360,9 +362,9 @@ fn run(cli: Cli) -> ExitCode {
         ),
         Command::Merge {
             inputs, out, quiet, ..
-        } => commands::merge::run(
+        } => commands::run::merge(
             &inputs,
-            commands::merge::Options {
+            commands::run::MergeOptions {
                 out,
                 jobs: rayon::current_num_threads(),
                 // Phase 1 and the search again, then Phase 3
@@ -373,7 +375,7 @@ fn run(cli: Cli) -> ExitCode {
             dir,
             tolerance,
             draw,
-        } => commands::report::run(&dir, tolerance, &draw),
+        } => Ok(commands::text::report(&dir, tolerance, &draw)),
         Command::ImportUrdf {
             urdf,
             out,

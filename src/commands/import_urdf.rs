@@ -12,7 +12,7 @@ pub fn run(urdf: &Path, out: Option<&Path>, options: ImportOptions) -> Result<Ex
     let imported = import(&text, &options).with_context(|| urdf.display().to_string())?;
     match out {
         Some(path) => {
-            super::write_atomic(path, imported.json.as_bytes())?;
+            counterpoise_study::write_file(path, imported.json.as_bytes())?;
             let model = &imported.model;
             eprintln!(
                 "wrote {}: {} bodies, {} coordinates, {} actuators",

@@ -13,6 +13,7 @@
 use std::io::IsTerminal;
 use std::time::{Duration, Instant};
 
+use counterpoise_study::progress::Count;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// The label of a phase outside the count ([`Progress::extra_phase`]).
@@ -112,34 +113,6 @@ pub fn time_left(elapsed: Duration, done: usize, total: usize) -> Option<Duratio
     (done > 0 && done <= total).then(|| elapsed.mul_f64((total - done) as f64 / done as f64))
 }
 
-/// How far a stage is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Count {
-    /// `done` of `total` items (variants), shown as `312/1169`.
-    Items { done: usize, total: usize },
-    /// `done` of `total` of work whose items all end together (a grid evaluation of many
-    /// variants), shown as a percentage.
-    Share { done: usize, total: usize },
-}
-
-impl Count {
-    fn parts(self) -> (usize, usize) {
-        match self {
-            Count::Items { done, total } | Count::Share { done, total } => (done, total),
-        }
-    }
-
-    /// `312/1169` or `41 %`.
-    pub fn shown(self) -> String {
-        match self {
-            Count::Items { done, total } => format!("{done}/{total}"),
-            Count::Share { done, total } => {
-                format!("{} %", (100 * done.min(total)) / total.max(1))
-            }
-        }
-    }
-}
-
 impl Phase {
     /// The phase's work reached `count` in `stage` (called from any thread).
     pub fn report(&self, stage: &str, count: Count) {
@@ -178,6 +151,32 @@ impl Phase {
                 self.started.elapsed().as_secs_f64()
             ));
         }
+    }
+}
+
+impl counterpoise_study::Progress for Progress {
+    fn phase(&mut self, name: &str, extra: bool) -> Box<dyn counterpoise_study::Phase> {
+        Box::new(if extra {
+            self.extra_phase(name)
+        } else {
+            Progress::phase(self, name)
+        })
+    }
+
+    fn note(&mut self, text: &str) {
+        if self.mode != Mode::Quiet {
+            eprintln!("note: {text}");
+        }
+    }
+}
+
+impl counterpoise_study::Phase for Phase {
+    fn report(&self, stage: &str, count: Count) {
+        Phase::report(self, stage, count)
+    }
+
+    fn finish(self: Box<Self>) {
+        Phase::finish(*self)
     }
 }
 

@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context as _, Result, bail};
+use crate::error::{Result, StudyError, invalid};
 use counterpoise_dynamics::Indicators;
 use counterpoise_model::Model;
 use counterpoise_optimise::{Objective, OptimisedStatus, OptimisedVariant};
@@ -239,7 +239,7 @@ impl OptimisedRecord {
 /// Writes `file` into `dir` as `shard-I-of-N.json`, atomically (a temporary file renamed into
 /// place): a shard killed while writing leaves no file `merge` could take for a complete one.
 pub fn write(dir: &Path, file: &ShardFile) -> Result<PathBuf> {
-    let json = serde_json::to_vec(file).context("serialising the shard")?;
+    let json = serde_json::to_vec(file)?;
     let name = file_name(file.shard, file.study.shards);
     Ok(counterpoise_report::output::write_atomic(
         dir, &name, &json,
@@ -248,14 +248,19 @@ pub fn write(dir: &Path, file: &ShardFile) -> Result<PathBuf> {
 
 /// Reads one shard file, checking its format.
 pub fn read(path: &Path) -> Result<ShardFile> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read the shard file", path.display()))?;
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        StudyError::io(format!("{}: cannot read the shard file", path.display()), e)
+    })?;
     // The format first, so that another JSON file is named as such rather than by the first
     // field serde misses.
-    let value: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a shard file (invalid JSON)", path.display()))?;
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+        StudyError::Invalid(format!(
+            "{}: not a shard file (invalid JSON): {e}",
+            path.display()
+        ))
+    })?;
     if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
-        bail!(
+        invalid!(
             "{}: not a shard file (no \"format\": \"{FORMAT}\"; shard files are written by \
              `counterpoise run CASE --shard I/N`)",
             path.display()
@@ -263,15 +268,16 @@ pub fn read(path: &Path) -> Result<ShardFile> {
     }
     let version = value.get("format_version").and_then(|v| v.as_u64());
     if version != Some(u64::from(FORMAT_VERSION)) {
-        bail!(
+        invalid!(
             "{}: shard file format version {} is not supported (this build reads version \
              {FORMAT_VERSION})",
             path.display(),
             version.map_or("(missing)".to_string(), |v| v.to_string())
         );
     }
-    serde_json::from_value(value)
-        .with_context(|| format!("{}: not a valid shard file", path.display()))
+    serde_json::from_value(value).map_err(|e| {
+        StudyError::Invalid(format!("{}: not a valid shard file: {e}", path.display()))
+    })
 }
 
 #[cfg(test)]

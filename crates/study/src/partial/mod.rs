@@ -7,10 +7,8 @@
 pub mod fallback;
 
 use std::path::Path;
-use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Result, bail};
 use counterpoise_balance::linear::LiftedBasis;
 use counterpoise_balance::partial::{
     CERTIFY, CounterweightLimits, ElementLimits, PartialDesign, PartialOptions, PartialReport,
@@ -26,6 +24,9 @@ use counterpoise_model::limits::{Limit, format_count};
 use counterpoise_model::{Model, ModelError};
 use counterpoise_optimise::{BoundsTable, ElementBounds};
 use serde_json::json;
+
+use crate::error::{Result, StudyError, invalid};
+use crate::guards::located;
 
 /// Version of the `partial --json` document (documented in README.md).
 pub const SCHEMA_VERSION: u32 = 1;
@@ -74,7 +75,7 @@ fn select_joints(model: &Model, names: Option<&[String]>) -> Result<Vec<usize>> 
                         }
                     })
                     .collect();
-                bail!(
+                invalid!(
                     "--joints: `{name}` is neither an actuator nor an actuated joint of the case; \
                      the actuators are {}",
                     valid.join(", ")
@@ -83,7 +84,7 @@ fn select_joints(model: &Model, names: Option<&[String]>) -> Result<Vec<usize>> 
         }
     }
     if picked.is_empty() {
-        bail!("--joints: no joint named");
+        invalid!("--joints: no joint named");
     }
     picked.sort_unstable();
     picked.dedup();
@@ -94,18 +95,18 @@ fn select_joints(model: &Model, names: Option<&[String]>) -> Result<Vec<usize>> 
 /// equally spaced values over that axis; an axis with one value keeps it.
 fn workspace_points(model: &Model, points: Option<usize>) -> Result<(Vec<Vec<f64>>, usize)> {
     let Some(tasks) = &model.tasks else {
-        bail!("the case has no `tasks` grid: partial balancing samples the workspace over it");
+        invalid!("the case has no `tasks` grid: partial balancing samples the workspace over it");
     };
     let varying = tasks.grid.iter().filter(|a| a.n > 1).count() as u32;
-    let limit = counterpoise::preflight::limits().get(Limit::GridPoints);
+    let limit = crate::preflight::limits().get(Limit::GridPoints);
     let n = match points {
         Some(n) => {
             if n < 2 {
-                bail!("--points must be at least 2");
+                invalid!("--points must be at least 2");
             }
             let total = (n as f64).powi(varying as i32);
             if total > limit as f64 {
-                bail!(
+                invalid!(
                     "--points {n}: {} workspace points ({n}^{varying}); the limit is {}; lower \
                      --points, or {}",
                     format_count(total),
@@ -169,22 +170,21 @@ fn limits(model: &Model, catalogue: &Catalogue) -> Result<Vec<Option<ElementLimi
         .collect())
 }
 
-pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
-    let Some(model) = super::load(path)? else {
-        return Ok(ExitCode::FAILURE);
-    };
+/// `counterpoise partial`: the best partial balancings within the budget, as tables or as
+/// the JSON document.
+pub fn partial_text(path: &Path, model: &Model, options: &Options) -> Result<String> {
     let Some(balancing) = &model.balancing else {
-        bail!("{}: the case has no `balancing` section", path.display());
+        invalid!("{}: the case has no `balancing` section", path.display());
     };
     let budget = options.budget.unwrap_or(balancing.dmax);
     if budget == 0 {
-        bail!("--budget must be at least 1");
+        invalid!("--budget must be at least 1");
     }
-    let joints = select_joints(&model, options.joints.as_deref())?;
-    let energy = mechanism_energy(&model);
-    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+    let joints = select_joints(model, options.joints.as_deref())?;
+    let energy = mechanism_energy(model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
     if candidate_entries(&catalogue, options.springs).is_empty() {
-        bail!(
+        invalid!(
             "{}: `balancing` allows no counterweight{}",
             path.display(),
             if options.springs {
@@ -195,26 +195,27 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
         );
     }
     if let Err(e) = set_guard_for(&catalogue, budget, options.springs) {
-        super::print_errors(path, &super::located(path, vec![e]));
-        return Ok(ExitCode::FAILURE);
+        return Err(StudyError::Case {
+            path: path.to_path_buf(),
+            errors: located(Some(path), vec![e]),
+        });
     }
     let computed = compute_with(
-        &model,
+        model,
         budget,
         joints,
         options.points,
         options.top,
         options.springs,
     )?;
-    if options.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&to_json(&model, &computed))?
-        );
+    Ok(if options.json {
+        format!(
+            "{}\n",
+            serde_json::to_string_pretty(&to_json(model, &computed))?
+        )
     } else {
-        print!("{}", tables(&model, &computed));
-    }
-    Ok(ExitCode::SUCCESS)
+        tables(model, &computed)
+    })
 }
 
 /// The variant limit applied to the number of sets [`compute`] solves (counterweights).
@@ -225,7 +226,7 @@ fn set_guard(catalogue: &Catalogue, budget: usize) -> Result<(), ModelError> {
 /// [`set_guard`] for the sets of counterweights only when `springs` is false.
 fn set_guard_for(catalogue: &Catalogue, budget: usize, springs: bool) -> Result<(), ModelError> {
     let sets = set_count(catalogue, budget, springs);
-    let limit = counterpoise::preflight::limits().get(Limit::Variants);
+    let limit = crate::preflight::limits().get(Limit::Variants);
     if sets > u128::from(limit) {
         return Err(ModelError::Invalid {
             path: "--budget".into(),
@@ -305,7 +306,7 @@ pub fn compute_with(
     }
     let workspace = Workspace::new(model, &configurations);
     if workspace.is_empty() {
-        bail!(
+        invalid!(
             "none of the {} workspace points is reachable with a regular actuator Jacobian",
             targets.len()
         );

@@ -1,41 +1,45 @@
 //! `counterpoise check CASE`: validate a case and summarise the mechanism.
 
 use std::path::Path;
-use std::process::ExitCode;
 
-use anyhow::Result;
 use counterpoise_model::{Model, PayloadMode};
 use counterpoise_symbolic::VarKind;
 
-use counterpoise::preflight::GridReach;
+use crate::error::{Result, StudyError};
+use crate::guards::{derived_bounds_note, located};
+use crate::preflight::{self, GridReach};
 
-pub fn run(path: &Path) -> Result<ExitCode> {
-    let Some(model) = super::load(path)? else {
-        return Ok(ExitCode::FAILURE);
-    };
-    // What `variants`, `evaluate` and `run` would otherwise find only later.
-    let (problems, reach) = counterpoise::preflight::problems(&model);
-    let overrides = override_errors(&model);
+/// `counterpoise check`'s report on a loaded case: the mechanism's summary, the reach of the
+/// task grid and the sections the case lacks; or every problem `variants`, `evaluate` and
+/// `run` would otherwise find only later.
+pub fn check(path: &Path, model: &Model) -> Result<String> {
+    let (problems, reach) = preflight::problems(model);
+    let overrides = override_errors(model);
     if !problems.is_empty() || !overrides.is_empty() {
+        let mut text = Vec::new();
         if !problems.is_empty() {
-            super::print_errors(path, &super::located(path, problems));
+            text.push(
+                StudyError::Case {
+                    path: path.to_path_buf(),
+                    errors: located(Some(path), problems),
+                }
+                .to_string(),
+            );
         }
         if !overrides.is_empty() {
-            eprintln!("{}: {} error(s)", path.display(), overrides.len());
-            for e in &overrides {
-                eprintln!("  {e}");
-            }
+            text.push(format!("{}: {} error(s)", path.display(), overrides.len()));
+            text.extend(overrides.iter().map(|e| format!("  {e}")));
         }
-        return Ok(ExitCode::FAILURE);
+        return Err(StudyError::Problems(text.join("\n")));
     }
-    print!("{}", summary(&model));
+    let mut out = summary(model);
     if let Some(reach) = &reach {
-        print!("{}", reachability(&model, reach));
+        out.push_str(&reachability(model, reach));
     }
-    for missing in missing_sections(&model) {
-        println!("note: {missing}");
+    for missing in missing_sections(model) {
+        out.push_str(&format!("note: {missing}\n"));
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(out)
 }
 
 /// The optional sections a command needs but the case lacks.
@@ -233,7 +237,7 @@ pub fn summary(model: &Model) -> String {
             }
         };
         line(&mut out, format!("balance decision: {decision}"));
-        if let Some(note) = super::derived_bounds_note(model) {
+        if let Some(note) = derived_bounds_note(model) {
             line(&mut out, note);
         }
     }

@@ -9,9 +9,8 @@
 //! the task evaluator.
 
 use std::path::Path;
-use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
+use crate::error::{Result, StudyError, invalid};
 use counterpoise_model::{Kinematics, Model};
 use nalgebra::{DVector, Matrix3, Vector3};
 use serde::Deserialize;
@@ -52,35 +51,34 @@ fn lumped(model: &Model, body: usize) -> (f64, Vector3<f64>, Matrix3<f64>) {
     (mass, com, inertia)
 }
 
-pub fn run(case: &Path, states: &Path) -> Result<ExitCode> {
-    let Some(model) = super::load(case)? else {
-        return Ok(ExitCode::FAILURE);
-    };
+/// Inverse dynamics of `model` at the states in the file `states`, as the JSON document
+/// `counterpoise evaluate --states` prints.
+pub fn states_json(model: &Model, states: &Path) -> Result<String> {
     let text = std::fs::read_to_string(states)
-        .with_context(|| format!("cannot read {}", states.display()))?;
-    let list: Vec<State> = serde_json::from_str(&text).with_context(|| {
-        format!(
-            "{}: expected a JSON array of {{\"q\": [..], \"qd\": [..], \"qdd\": [..]}}",
+        .map_err(|e| StudyError::io(format!("cannot read {}", states.display()), e))?;
+    let list: Vec<State> = serde_json::from_str(&text).map_err(|e| {
+        StudyError::Invalid(format!(
+            "{}: expected a JSON array of {{\"q\": [..], \"qd\": [..], \"qdd\": [..]}}: {e}",
             states.display()
-        )
+        ))
     })?;
     let n = model.coordinates.len();
-    let kin = Kinematics::new(&model);
-    let lumps: Vec<_> = (0..model.bodies.len()).map(|b| lumped(&model, b)).collect();
+    let kin = Kinematics::new(model);
+    let lumps: Vec<_> = (0..model.bodies.len()).map(|b| lumped(model, b)).collect();
     let g = model.gravity;
     let mut out = Vec::with_capacity(list.len());
     for (s, state) in list.iter().enumerate() {
         let vector = |field: &str, v: &Option<Vec<f64>>| -> Result<DVector<f64>> {
             let v = v.clone().unwrap_or_else(|| vec![0.0; n]);
             if v.len() != n {
-                bail!(
+                invalid!(
                     "{}: states[{s}].{field}: {} values for {n} coordinates",
                     states.display(),
                     v.len()
                 );
             }
             if let Some(bad) = v.iter().find(|x| !x.is_finite()) {
-                bail!(
+                invalid!(
                     "{}: states[{s}].{field}: {bad} is not finite",
                     states.display()
                 );
@@ -111,7 +109,7 @@ pub fn run(case: &Path, states: &Path) -> Result<ExitCode> {
         }
         let jacobian = kin.actuator_jacobian(&q);
         let Some(forces) = jacobian.transpose().lu().solve(&generalized) else {
-            bail!(
+            invalid!(
                 "{}: states[{s}]: the actuator Jacobian is singular at this q",
                 states.display()
             );
@@ -137,6 +135,5 @@ pub fn run(case: &Path, states: &Path) -> Result<ExitCode> {
         "actuators": model.actuators.iter().map(|a| &a.name).collect::<Vec<_>>(),
         "states": out,
     });
-    println!("{}", serde_json::to_string_pretty(&doc)?);
-    Ok(ExitCode::SUCCESS)
+    Ok(format!("{}\n", serde_json::to_string_pretty(&doc)?))
 }

@@ -6,47 +6,49 @@
 //! shard 1…N is there exactly once. The merge then recomputes Phase 1 and the balance search
 //! from the case text the shards carry, checks that each shard optimised exactly the variants
 //! the partition gives it and saw the same unbalanced robot, and runs Phase 3 through
-//! [`super::run::finish`], as a single run does.
+//! [`Study::finish`], as a single run does.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
 
-use anyhow::{Context as _, Result, bail};
-use counterpoise::shard::{ShardSpec, shard_variants};
 use counterpoise_model::Case;
+use counterpoise_optimise::Objective;
 use counterpoise_report::{PhaseTiming, RankingOptions};
 
-use super::run::{Study, Timer, checked_dmax, finish, front};
-use super::shard_file::{self, OptimisedRecord, ShardFile};
+use crate::error::{Result, StudyError, invalid};
+use crate::preflight;
+use crate::progress::Progress;
+use crate::shard::{ShardSpec, shard_variants};
+use crate::shard_file::{self, OptimisedRecord, ShardFile};
+use crate::study::{Study, StudyOptions, StudyOutcome, Timer};
 
-/// Options of the command.
-pub struct Options {
-    pub out: PathBuf,
-    pub jobs: usize,
-    pub progress: super::progress::Progress,
-}
-
-pub fn run(inputs: &[PathBuf], options: Options) -> Result<ExitCode> {
-    let shards = read_shards(inputs)?;
+/// Merges the shards of one study (as [`read_shards`] returns them) into the results a single
+/// run gives: the case is rebuilt from the text the shards carry and checked against its
+/// hash, Phase 1 and the search are run again, every shard is checked against them, and Phase
+/// 3 runs on all the records.
+pub fn merge(
+    shards: &[(PathBuf, ShardFile)],
+    jobs: usize,
+    progress: &mut dyn Progress,
+    cancel: &AtomicBool,
+) -> Result<StudyOutcome> {
     let (first_path, first) = &shards[0];
     let text = &first.case_text;
-    let model = match Case::from_json_str_with(text, counterpoise::preflight::limits()) {
+    let model = match Case::from_json_str_with(text, preflight::limits()) {
         Ok(model) => model,
         Err(errors) => {
-            eprintln!(
+            let mut lines = vec![format!(
                 "{}: the case text in the shard file is not a valid case:",
                 first_path.display()
-            );
-            for line in errors.lines() {
-                eprintln!("  {line}");
-            }
-            return Ok(ExitCode::FAILURE);
+            )];
+            lines.extend(errors.lines().iter().map(|l| format!("  {l}")));
+            return Err(StudyError::Problems(lines.join("\n")));
         }
     };
     let hash = shard_file::case_sha256(&model)?;
     if hash != first.study.case_sha256 {
-        bail!(
+        invalid!(
             "{}: the case text does not match the case hash recorded with it ({} ≠ {}): the \
              file was edited or damaged",
             first_path.display(),
@@ -54,32 +56,38 @@ pub fn run(inputs: &[PathBuf], options: Options) -> Result<ExitCode> {
             first.study.case_sha256
         );
     }
-    let case_path = Path::new(&first.case_path);
-    let dmax = first.study.dmax;
-    let Some(dmax) = checked_dmax(case_path, &model, Some(dmax), options.progress.mode)? else {
-        return Ok(ExitCode::FAILURE);
-    };
-    std::fs::create_dir_all(&options.out).with_context(|| {
-        format!(
-            "cannot create the output directory {}",
-            options.out.display()
-        )
-    })?;
-    let mut timer = Timer::new(options.progress);
-    let front = front(&model, dmax, &mut timer)?;
+    let study = Study::new(
+        &model,
+        StudyOptions {
+            dmax: Some(first.study.dmax),
+            minimax: first.study.objective == Objective::Minimax,
+            ranking: RankingOptions {
+                resolution: first.study.resolution,
+                tolerance: first.study.tolerance,
+            },
+            jobs,
+            case_path: Some(PathBuf::from(&first.case_path)),
+            ..StudyOptions::default()
+        },
+    )?;
+    for note in study.notes() {
+        progress.note(note);
+    }
+    let mut timer = Timer::new(progress, cancel);
+    let front = study.front(&mut timer)?;
 
     let count = first.study.shards;
     let unbalanced = serde_json::to_value(&front.unbalanced)?;
     let mut optimised: Vec<OptimisedRecord> = Vec::new();
     let mut shard_timings: Vec<PhaseTiming> = Vec::new();
-    for (path, shard) in &shards {
+    for (path, shard) in shards {
         let spec = ShardSpec {
             index: shard.shard,
             count,
         };
         let expected = shard_variants(&front.found.variants, spec);
         if shard.variants != expected {
-            bail!(
+            invalid!(
                 "{}: shard {spec} optimised other variants than the partition of this study \
                  gives it ({} listed, {} expected): it was written by another build",
                 path.display(),
@@ -89,7 +97,7 @@ pub fn run(inputs: &[PathBuf], options: Options) -> Result<ExitCode> {
         }
         let ids: Vec<usize> = shard.optimised.iter().map(|o| o.variant).collect();
         if ids != expected {
-            bail!(
+            invalid!(
                 "{}: shard {spec} holds {} optimisation results for its {} variants: the file \
                  is damaged",
                 path.display(),
@@ -104,7 +112,7 @@ pub fn run(inputs: &[PathBuf], options: Options) -> Result<ExitCode> {
                 .map(|e| e.label.as_str())
                 .collect();
             if o.elements != elements {
-                bail!(
+                invalid!(
                     "{}: variant {} is {} in the shard but {} in this study",
                     path.display(),
                     o.variant,
@@ -114,7 +122,7 @@ pub fn run(inputs: &[PathBuf], options: Options) -> Result<ExitCode> {
             }
         }
         if serde_json::to_value(&shard.unbalanced)? != unbalanced {
-            bail!(
+            invalid!(
                 "{}: shard {spec} computed other Phase 1 indicators of the unbalanced robot than \
                  this merge: run every shard and the merge with the same counterpoise build",
                 path.display()
@@ -126,29 +134,21 @@ pub fn run(inputs: &[PathBuf], options: Options) -> Result<ExitCode> {
             seconds: t.seconds,
         }));
     }
-    let study = Study {
-        model: &model,
-        case_path: first.case_path.clone(),
-        dmax,
-        jobs: options.jobs,
-        ranking: RankingOptions {
-            resolution: first.study.resolution,
-            tolerance: first.study.tolerance,
-        },
-        shards: Some(count),
-        shard_timings,
-    };
-    finish(&study, &front, &optimised, timer, &options.out)
+    study
+        .merged(count, shard_timings)
+        .finish(&front, &optimised, timer)
 }
 
 /// The shard files of `inputs` (directories are searched for `shard-*-of-*.json`), checked to
 /// be the shards 1…N of one study, each once; sorted by shard index.
-fn read_shards(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, ShardFile)>> {
+pub fn read_shards(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, ShardFile)>> {
     let mut paths = Vec::new();
     for input in inputs {
         if input.is_dir() {
             let mut found: Vec<PathBuf> = std::fs::read_dir(input)
-                .with_context(|| format!("cannot read the directory {}", input.display()))?
+                .map_err(|e| {
+                    StudyError::io(format!("cannot read the directory {}", input.display()), e)
+                })?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| {
                     p.file_name()
@@ -161,11 +161,11 @@ fn read_shards(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, ShardFile)>> {
         } else if input.exists() {
             paths.push(input.clone());
         } else {
-            bail!("{}: no such file or directory", input.display());
+            invalid!("{}: no such file or directory", input.display());
         }
     }
     if paths.is_empty() {
-        bail!(
+        invalid!(
             "no shard files (shard-I-of-N.json) in {}",
             inputs
                 .iter()
@@ -184,21 +184,21 @@ fn read_shards(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, ShardFile)>> {
     let mut seen: BTreeMap<usize, &Path> = BTreeMap::new();
     for (path, shard) in &shards {
         if let Some(difference) = first.study.difference(&shard.study) {
-            bail!(
+            invalid!(
                 "{}: belongs to another study than {} ({difference})",
                 path.display(),
                 first_path.display()
             );
         }
         if shard.shard == 0 || shard.shard > count {
-            bail!(
+            invalid!(
                 "{}: shard index {} is outside 1…{count}",
                 path.display(),
                 shard.shard
             );
         }
         if let Some(other) = seen.insert(shard.shard, path) {
-            bail!(
+            invalid!(
                 "shard {}/{count} appears twice: {} and {}",
                 shard.shard,
                 other.display(),
@@ -211,7 +211,7 @@ fn read_shards(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, ShardFile)>> {
         let list = |f: &dyn Fn(usize) -> String| {
             missing.iter().map(|&i| f(i)).collect::<Vec<_>>().join(", ")
         };
-        bail!(
+        invalid!(
             "the study of {} has {count} shards; missing: {} (no {}; rerun a missing shard \
              with `counterpoise run CASE --shard I/{count} --out DIR`)",
             first_path.display(),

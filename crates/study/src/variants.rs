@@ -1,10 +1,8 @@
 //! `counterpoise variants CASE`: the exact balance search and its results.
 
 use std::path::Path;
-use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Result, bail};
 use counterpoise_balance::minimal::{MinimalReport, estimate_tested, minimal_search};
 use counterpoise_balance::{
     Arithmetic, Attachment, Catalogue, Class, Decision, SearchOptions, SearchReport, Status,
@@ -14,15 +12,24 @@ use counterpoise_model::limits::{Limit, format_count};
 use counterpoise_model::{Model, ModelError, Plane};
 use serde_json::json;
 
+use crate::error::{Result, StudyError, invalid};
+use crate::guards::located;
+use crate::preflight;
+
 /// Version of the `variants --json` schema (documented in README.md).
 pub const SCHEMA_VERSION: u32 = 1;
 
-pub fn run(path: &Path, dmax: Option<usize>, as_json: bool, minimal: bool) -> Result<ExitCode> {
-    let Some(model) = super::load(path)? else {
-        return Ok(ExitCode::FAILURE);
-    };
+/// `counterpoise variants`: every set of at most Dmax elements decided (or, with `minimal`,
+/// the minimal balancing sets), as tables or as the JSON document.
+pub fn variants_text(
+    path: &Path,
+    model: &Model,
+    dmax: Option<usize>,
+    as_json: bool,
+    minimal: bool,
+) -> Result<String> {
     let Some(balancing) = &model.balancing else {
-        bail!("{}: the case has no `balancing` section", path.display());
+        invalid!("{}: the case has no `balancing` section", path.display());
     };
     let source = if dmax.is_some() {
         "--dmax"
@@ -31,20 +38,19 @@ pub fn run(path: &Path, dmax: Option<usize>, as_json: bool, minimal: bool) -> Re
     };
     let dmax = dmax.unwrap_or(balancing.dmax);
     if dmax == 0 {
-        bail!("--dmax must be at least 1");
+        invalid!("--dmax must be at least 1");
     }
     if minimal {
-        return run_minimal(path, &model, dmax, source, as_json);
+        return run_minimal(path, model, dmax, source, as_json);
     }
-    if let Err(e) = counterpoise::preflight::variant_guard(&model, dmax, source) {
-        super::print_errors(path, &super::located(path, vec![e]));
-        return Ok(ExitCode::FAILURE);
+    if let Err(e) = preflight::variant_guard(model, dmax, source) {
+        return Err(refused(path, e));
     }
     let started = Instant::now();
-    let energy = mechanism_energy(&model);
-    let catalogue = Catalogue::build(&energy, &catalogue_options(&model));
+    let energy = mechanism_energy(model);
+    let catalogue = Catalogue::build(&energy, &catalogue_options(model));
     if catalogue.is_empty() {
-        bail!(
+        invalid!(
             "{}: `balancing` allows no counterweight and no spring",
             path.display()
         );
@@ -54,19 +60,18 @@ pub fn run(path: &Path, dmax: Option<usize>, as_json: bool, minimal: bool) -> Re
         catalogue,
         SearchOptions {
             dmax,
-            hints: realization_hints(&model),
+            hints: realization_hints(model),
         },
     );
     let elapsed = started.elapsed().as_secs_f64();
-    if as_json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&to_json(&model, dmax, &report, elapsed))?
-        );
+    Ok(if as_json {
+        format!(
+            "{}\n",
+            serde_json::to_string_pretty(&to_json(model, dmax, &report, elapsed))?
+        )
     } else {
-        print!("{}", tables(&model, dmax, &report, elapsed));
-    }
-    Ok(ExitCode::SUCCESS)
+        tables(model, dmax, &report, elapsed)
+    })
 }
 
 /// The `--json` document.
@@ -312,12 +317,12 @@ pub const WALK_TESTS_PER_VARIANT: u64 = 100;
 
 /// The variant guard of `--minimal`: the pruned walk's size (the reach pruning alone, an upper
 /// estimate of the sets it tests) against the variants limit, instead of `C(n, ≤ Dmax)`.
-pub(super) fn minimal_guard(
+pub fn minimal_guard(
     exact: &counterpoise_balance::exact::ExactBasis,
     dmax: usize,
     source: &str,
 ) -> Result<u64, ModelError> {
-    let limits = counterpoise::preflight::limits();
+    let limits = preflight::limits();
     let refuse = |what: String, found: f64, limit: Limit| ModelError::Invalid {
         path: source.to_string(),
         reason: format!(
@@ -360,27 +365,26 @@ fn run_minimal(
     dmax: usize,
     source: &str,
     as_json: bool,
-) -> Result<ExitCode> {
+) -> Result<String> {
     let started = Instant::now();
     let energy = mechanism_energy(model);
     let catalogue = Catalogue::build(&energy, &catalogue_options(model));
     if catalogue.is_empty() {
-        bail!(
+        invalid!(
             "{}: `balancing` allows no counterweight and no spring",
             path.display()
         );
     }
     let exact = match &energy.exact {
         Ok(mechanism) => counterpoise_balance::exact::ExactBasis::build(mechanism, &catalogue),
-        Err(reason) => bail!(
+        Err(reason) => invalid!(
             "{}: minimal sets need an exact case (every number rational); this one is decided \
              in floating point: {reason}",
             path.display()
         ),
     };
     if let Err(e) = minimal_guard(&exact, dmax, source) {
-        super::print_errors(path, &super::located(path, vec![e]));
-        return Ok(ExitCode::FAILURE);
+        return Err(refused(path, e));
     }
     let report = minimal_search(
         &energy,
@@ -391,15 +395,14 @@ fn run_minimal(
         },
     )?;
     let elapsed = started.elapsed().as_secs_f64();
-    if as_json {
-        println!(
-            "{}",
+    Ok(if as_json {
+        format!(
+            "{}\n",
             serde_json::to_string_pretty(&minimal_json(model, dmax, &report, elapsed))?
-        );
+        )
     } else {
-        print!("{}", minimal_tables(model, dmax, &report, elapsed));
-    }
-    Ok(ExitCode::SUCCESS)
+        minimal_tables(model, dmax, &report, elapsed)
+    })
 }
 
 /// The `variants --minimal --json` document.
@@ -551,6 +554,14 @@ pub fn minimal_tables(model: &Model, dmax: usize, report: &MinimalReport, second
         }
     }
     out
+}
+
+/// A guard's refusal, located in the case file.
+fn refused(path: &Path, e: ModelError) -> StudyError {
+    StudyError::Case {
+        path: path.to_path_buf(),
+        errors: located(Some(path), vec![e]),
+    }
 }
 
 #[cfg(test)]

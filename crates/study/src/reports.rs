@@ -3,24 +3,36 @@
 //! bounds of each element) is there for results written by earlier versions too; a case echo
 //! that no longer validates leaves those parts out, with a note on stderr.
 
-use std::path::Path;
-use std::process::ExitCode;
+use std::path::{Path, PathBuf};
 
-use anyhow::Result;
-use counterpoise::preflight;
 use counterpoise_model::{Case, Model};
 use counterpoise_report as report;
+
+use crate::error::{Result, invalid};
+use crate::figures::{
+    add_practical_figures, add_torque_charts, path_configurations, path_simulation,
+    shown_mechanisms_of_results,
+};
+use crate::{design, preflight};
+
+/// The reports written again, and what the user should know about them.
+pub struct Rewritten {
+    pub written: Vec<PathBuf>,
+    /// Why parts were left out (the case echo no longer validates).
+    pub notes: Vec<String>,
+}
 
 /// Rewrites the reports, with the decision recomputed (at `tolerance` when one is given, else
 /// at the tolerance the results were decided at: the idle elements are marked anew, and the
 /// recommendation never holds one).
-pub fn run(dir: &Path, tolerance: Option<f64>, draw: &[String]) -> Result<ExitCode> {
+pub fn rewrite_reports(dir: &Path, tolerance: Option<f64>, draw: &[String]) -> Result<Rewritten> {
     let mut results = report::read_results(dir)?;
-    let model = model_of(&results);
+    let mut notes = Vec::new();
+    let model = model_of(&results, &mut notes);
     if let Some(model) = &model
         && results.element_bounds.is_empty()
     {
-        results.element_bounds = super::design::element_bounds(model)?;
+        results.element_bounds = design::element_bounds(model)?;
     }
     if let Some(model) = &model
         && lacks_spring_lengths(&results)
@@ -30,9 +42,9 @@ pub fn run(dir: &Path, tolerance: Option<f64>, draw: &[String]) -> Result<ExitCo
         let path = if model.paths.is_empty() {
             Vec::new()
         } else {
-            super::run::path_configurations(model, 0)?
+            path_configurations(model, 0)?
         };
-        super::run::add_practical_figures(model, &mut results, path)?;
+        add_practical_figures(model, &mut results, path)?;
     }
     let tolerance = tolerance
         .or_else(|| results.decision.as_ref().map(|d| d.tolerance))
@@ -43,41 +55,36 @@ pub fn run(dir: &Path, tolerance: Option<f64>, draw: &[String]) -> Result<ExitCo
             if charts_are_stale(&results) {
                 // The decision picked variants the stored curves do not show (another
                 // --tolerance, or idle elements marked): compute them again.
-                let m = super::run::shown_mechanisms_of_results(model, &results)?;
-                super::run::add_torque_charts(model, &mut results, &m)?;
+                let m = shown_mechanisms_of_results(model, &results)?;
+                add_torque_charts(model, &mut results, &m)?;
                 if !model.paths.is_empty() {
-                    results.path = Some(super::run::path_simulation(model, &m, 0)?.0);
+                    results.path = Some(path_simulation(model, &m, 0)?.0);
                 }
                 results.finalize_path()?;
             }
-            results.schematics = super::design::schematics(model, &results, draw)?;
-            results.energy = super::design::energy_chart(model, &results)?;
+            results.schematics = design::schematics(model, &results, draw)?;
+            results.energy = design::energy_chart(model, &results)?;
         }
         None if !draw.is_empty() => {
-            anyhow::bail!(
-                "--draw needs the model, and the case echo in results.json does not validate"
-            )
+            invalid!("--draw needs the model, and the case echo in results.json does not validate")
         }
         None => {}
     }
     let written = report::write_reports(dir, &results)?;
-    for f in written {
-        println!("wrote {}", f.display());
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(Rewritten { written, notes })
 }
 
-/// The model of the case echo, or `None` (said on stderr) when it does not validate.
-pub fn model_of(results: &report::RunResults) -> Option<Model> {
+/// The model of the case echo, or `None` (said in `notes`) when it does not validate.
+pub fn model_of(results: &report::RunResults, notes: &mut Vec<String>) -> Option<Model> {
     let text = serde_json::to_string(&results.case).ok()?;
     match Case::from_json_str_with(&text, preflight::limits()) {
         Ok(model) => Some(model),
         Err(errors) => {
-            eprintln!(
-                "note: the case echo in results.json does not validate ({} error(s)); the \
-                 reports leave out what needs the model",
+            notes.push(format!(
+                "the case echo in results.json does not validate ({} error(s)); the reports \
+                 leave out what needs the model",
                 errors.len()
-            );
+            ));
             None
         }
     }

@@ -1,52 +1,62 @@
 //! `counterpoise evaluate CASE`: Phase 1 — the unbalanced mechanism over its task grid.
 
 use std::path::Path;
-use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Result, bail};
 use counterpoise_dynamics::{
     DynamicsError, EvaluateOptions, EvaluationReport, evaluate, task_series,
 };
+use counterpoise_model::Model;
 
-/// Options of the command.
-pub struct Options<'a> {
+use crate::error::{Result, StudyError, invalid};
+use crate::guards::located;
+use crate::preflight;
+
+/// Options of `counterpoise evaluate`.
+pub struct Options {
     pub json: bool,
     pub samples: Option<usize>,
     pub no_reactions: bool,
-    /// `(i, j)` grid indices and the file to write the series to.
-    pub series: Option<((usize, usize), &'a Path)>,
 }
 
-pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
-    let Some(model) = super::load(path)? else {
-        return Ok(ExitCode::FAILURE);
-    };
+/// The guards of the command: a task grid, and samples within the limit.
+fn checked(path: &Path, model: &Model, samples: Option<usize>) -> Result<()> {
     let Some(tasks) = &model.tasks else {
-        bail!("{}: the case has no `tasks` section", path.display());
+        invalid!("{}: the case has no `tasks` section", path.display());
     };
-    if let Err(e) =
-        counterpoise::preflight::samples_guard(&model, options.samples.unwrap_or(tasks.samples))
-    {
-        super::print_errors(path, &super::located(path, vec![e]));
-        return Ok(ExitCode::FAILURE);
+    if let Err(e) = preflight::samples_guard(model, samples.unwrap_or(tasks.samples)) {
+        return Err(StudyError::Case {
+            path: path.to_path_buf(),
+            errors: located(Some(path), vec![e]),
+        });
     }
-    if let Some(((i, j), file)) = options.series {
-        let series = task_series(&model, i, j, options.samples).map_err(|e| match e {
-            // These name the task already.
-            DynamicsError::ZeroLengthTask { .. } | DynamicsError::NoSuchTask { .. } => {
-                anyhow::Error::new(e)
-            }
-            e => anyhow::Error::new(e).context(format!("task {i}→{j}")),
-        })?;
-        let text = serde_json::to_string_pretty(&series)?;
-        super::write_atomic(file, text.as_bytes())?;
-        eprintln!("wrote the series of task {i}→{j} to {}", file.display());
-        return Ok(ExitCode::SUCCESS);
-    }
+    Ok(())
+}
+
+/// The time series of task `i→j` (grid indices) as JSON.
+pub fn series_json(
+    path: &Path,
+    model: &Model,
+    (i, j): (usize, usize),
+    samples: Option<usize>,
+) -> Result<String> {
+    checked(path, model, samples)?;
+    let series = task_series(model, i, j, samples).map_err(|e| match e {
+        // These name the task already.
+        DynamicsError::ZeroLengthTask { .. } | DynamicsError::NoSuchTask { .. } => {
+            StudyError::from(e)
+        }
+        e => StudyError::Invalid(format!("task {i}→{j}: {e}")),
+    })?;
+    Ok(serde_json::to_string_pretty(&series)?)
+}
+
+/// Phase 1 of the unbalanced mechanism: its indicators as a summary, or as JSON.
+pub fn evaluate_text(path: &Path, model: &Model, options: &Options) -> Result<String> {
+    checked(path, model, options.samples)?;
     let started = Instant::now();
     let report = evaluate(
-        &model,
+        model,
         &EvaluateOptions {
             samples: options.samples,
             reactions: !options.no_reactions,
@@ -54,12 +64,11 @@ pub fn run(path: &Path, options: Options) -> Result<ExitCode> {
         },
     )?;
     let seconds = started.elapsed().as_secs_f64();
-    if options.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+    Ok(if options.json {
+        format!("{}\n", serde_json::to_string_pretty(&report)?)
     } else {
-        print!("{}", summary(&report, seconds));
-    }
-    Ok(ExitCode::SUCCESS)
+        summary(&report, seconds)
+    })
 }
 
 /// A task as every view writes it: `from→to`.

@@ -7,7 +7,7 @@
 
 use std::fmt::Write as _;
 
-use anyhow::Result;
+use crate::error::Result;
 use counterpoise_balance::exact::ExactField;
 use counterpoise_balance::linear::LiftedBasis;
 use counterpoise_balance::minimal::minimal_sets;
@@ -226,7 +226,7 @@ fn smallest(model: &Model, dmax: usize, found: &SearchReport) -> Smallest {
     let mut undecided = 0;
     let mut searched_to = dmax;
     for size in dmax + 1..=dmax + PROBE_BEYOND {
-        if super::super::variants::minimal_guard(exact, size, "--dmax").is_err() {
+        if crate::variants::minimal_guard(exact, size, "--dmax").is_err() {
             break;
         }
         let walk = minimal_sets(exact, size);

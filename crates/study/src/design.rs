@@ -4,7 +4,7 @@
 //! `run` and `merge` and by `report DIR`, which rebuilds the model from the case echo in
 //! results.json, so reports of older results gain them too.
 
-use anyhow::Result;
+use crate::error::{Result, invalid};
 use counterpoise_balance::{Catalogue, catalogue_options, mechanism_energy};
 use counterpoise_dynamics::{ParameterSet, Variant};
 use counterpoise_model::{BodyId, Kinematics, Model, PayloadMode};
@@ -212,7 +212,7 @@ pub fn schematics(
                     ids.push(v.id);
                 }
             }
-            None => anyhow::bail!(
+            None => invalid!(
                 "--draw {name}: no ranked variant of that name (SB1…SB{}) or elements",
                 results.ranked().len()
             ),

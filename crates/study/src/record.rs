@@ -1,0 +1,270 @@
+//! One variant as the results document records it: the search's verdict and, for a balanced
+//! variant, the optimiser's, converted from the stages' types into the report's; and the
+//! dynamics crate's description of an optimised variant.
+
+use std::time::{SystemTime, UNIX_EPOCH};
+
+use counterpoise_balance::{Status, VariantResult};
+use counterpoise_dynamics::{Counterweight, Indicators, Spring, Variant};
+use counterpoise_model::Model;
+use counterpoise_report as report;
+use report::{
+    ActuatorSummary, ElementInfo, ElementKind, Evaluation, FreeDirection, JointPeak, OptimiserInfo,
+    PhysicalParameters, VariantRecord, VariantStatus,
+};
+
+use crate::error::{Result, StudyError};
+use crate::shard_file::{OptimisedRecord, Outcome};
+
+pub(crate) fn capitalised(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
+}
+
+pub(crate) fn utc_now() -> String {
+    let secs = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    // civil-from-days (Howard Hinnant's algorithm): no date crate for one timestamp
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        (rem % 3600) / 60,
+        rem % 60
+    )
+}
+
+/// Indicators in the report's schema.
+pub(crate) fn evaluation(
+    ind: &Indicators,
+    (tasks, excluded, minimum_norm): (usize, usize, bool),
+) -> Evaluation {
+    Evaluation {
+        qtr: ind.qtr,
+        qtr_task: ind.qtr_task,
+        qit: ind.qit,
+        qit_task: ind.qit_task,
+        actuators: ind
+            .actuators
+            .iter()
+            .map(|a| ActuatorSummary {
+                name: a.name.clone(),
+                crt: a.crt,
+                crt_rms: a.crt_rms,
+                cpt: a.cpt,
+                cpt_peak: a.cpt_peak,
+            })
+            .collect(),
+        joints: ind
+            .joints
+            .iter()
+            .map(|j| JointPeak {
+                name: j.name.clone(),
+                force: j.force,
+                force_task: Some(j.force_task),
+                moment: j.moment,
+                moment_task: Some(j.moment_task),
+            })
+            .collect(),
+        tasks: tasks - excluded,
+        excluded_tasks: excluded,
+        reactions_minimum_norm: minimum_norm,
+    }
+}
+
+fn class(c: counterpoise_balance::Class) -> report::Class {
+    match c {
+        counterpoise_balance::Class::Counterweights => report::Class::Counterweights,
+        counterpoise_balance::Class::Springs => report::Class::Springs,
+        counterpoise_balance::Class::Hybrid => report::Class::Hybrid,
+    }
+}
+
+fn plane(p: Option<counterpoise_model::Plane>) -> Option<report::Plane> {
+    p.map(|p| match p {
+        counterpoise_model::Plane::Xy => report::Plane::Xy,
+        counterpoise_model::Plane::Yz => report::Plane::Yz,
+        counterpoise_model::Plane::Xz => report::Plane::Xz,
+    })
+}
+
+/// One variant's record: the search's verdict, and the optimiser's for balanced ones.
+pub(crate) fn record(
+    model: &Model,
+    id: usize,
+    v: &VariantResult,
+    opt: Option<&OptimisedRecord>,
+    grid_info: (usize, usize, bool),
+) -> VariantRecord {
+    let elements = v
+        .elements
+        .iter()
+        .map(|e| ElementInfo {
+            label: e.label.clone(),
+            kind: if e.kind == "spring" {
+                ElementKind::Spring
+            } else {
+                ElementKind::Counterweight
+            },
+            bodies: e.bodies.clone(),
+        })
+        .collect();
+    let status = match v.status {
+        Status::Balanced => VariantStatus::Feasible,
+        Status::Degenerate => VariantStatus::Degenerate,
+        Status::Unrealizable => VariantStatus::Unrealizable,
+        Status::Infeasible => VariantStatus::Infeasible,
+        Status::Undecided => VariantStatus::Undecided,
+    };
+    let mut r = VariantRecord::new(id, elements, class(v.class), status);
+    r.reason = v.reason.clone();
+    r.relations = v.relations.clone();
+    r.free_directions = v
+        .free_directions
+        .iter()
+        .map(|f| FreeDirection {
+            // Nine significant digits: the reports show four, and at Dmax 3 the directions
+            // of the ranked variants are half of results.json.
+            components: f
+                .components
+                .iter()
+                .map(|(name, c)| (name.clone(), significant(*c, 9)))
+                .collect(),
+            positive_interval: f.positive_interval,
+        })
+        .collect();
+    r.verification_residual = v.verification.map(|x| x.residual);
+    let Some(opt) = opt else {
+        r.relations.clear();
+        r.free_directions.clear();
+        return r;
+    };
+    r.optimiser = Some(OptimiserInfo {
+        objective: opt.objective,
+        lower_bound: opt.lower_bound,
+        gap: opt.gap,
+        iterations: Some(opt.iterations),
+        boxes: Some(opt.boxes),
+        message: opt.reason.clone(),
+    });
+    let balancing = model.balancing.as_ref();
+    let cw_plane = plane(
+        balancing
+            .and_then(|b| b.counterweights.as_ref())
+            .and_then(|c| c.plane),
+    );
+    let spring_plane = plane(
+        balancing
+            .and_then(|b| b.springs.as_ref())
+            .and_then(|s| s.plane),
+    );
+    r.parameters = Some(PhysicalParameters {
+        counterweights: opt
+            .counterweights
+            .iter()
+            .map(|c| report::CounterweightParams {
+                label: c.label.clone(),
+                body: c.body.clone(),
+                mass: c.mass,
+                offset: c.offset,
+                plane: cw_plane,
+            })
+            .collect(),
+        springs: opt
+            .springs
+            .iter()
+            .map(|s| report::SpringParams {
+                label: s.label.clone(),
+                body: s.body.clone(),
+                other: s.other.clone(),
+                stiffness: s.stiffness,
+                anchor_a: s.anchor_a,
+                anchor_b: s.anchor_b,
+                plane: spring_plane,
+            })
+            .collect(),
+    });
+    match (opt.outcome == Outcome::Feasible, &opt.indicators) {
+        (true, Some(ind)) => {
+            r.status = VariantStatus::Feasible;
+            r.evaluation = Some(evaluation(ind, grid_info));
+            if let Some(res) = opt.residual {
+                r.verification_residual = Some(res);
+            }
+        }
+        (true, None) => {
+            r.status = VariantStatus::Discarded;
+            r.reason = Some("optimised, but not re-evaluated over all tasks".into());
+        }
+        (false, _) => {
+            r.status = if opt.outcome == Outcome::Undecided {
+                VariantStatus::Undecided
+            } else {
+                VariantStatus::Discarded
+            };
+            r.reason = opt.reason.clone();
+        }
+    }
+    if r.status != VariantStatus::Feasible {
+        // The reports show the balance relations of ranked variants only; the free directions
+        // of thousands of unranked variants at Dmax 3 were most of results.json.
+        r.relations.clear();
+        r.free_directions.clear();
+    }
+    r
+}
+
+/// `x` rounded to `digits` significant digits (through the decimal representation, so the JSON
+/// holds the short form).
+fn significant(x: f64, digits: usize) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    format!("{x:.*e}", digits.saturating_sub(1))
+        .parse()
+        .unwrap_or(x)
+}
+
+/// The dynamics crate's description of a variant's elements.
+pub(crate) fn dynamics_variant(model: &Model, opt: &OptimisedRecord) -> Result<Variant> {
+    let body = |name: &str| {
+        model
+            .body_index(name)
+            .ok_or_else(|| StudyError::Invalid(format!("optimiser named an unknown body `{name}`")))
+    };
+    let mut v = Variant::default();
+    for c in &opt.counterweights {
+        v.counterweights.push(Counterweight {
+            body: body(&c.body)?,
+            mass: c.mass,
+            position: c.offset,
+        });
+    }
+    for s in &opt.springs {
+        v.springs.push(Spring {
+            body: body(&s.body)?,
+            other: if s.other == "base" {
+                None
+            } else {
+                Some(body(&s.other)?)
+            },
+            stiffness: s.stiffness,
+            anchor: s.anchor_a,
+            other_anchor: s.anchor_b,
+        });
+    }
+    Ok(v)
+}
