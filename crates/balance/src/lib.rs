@@ -38,6 +38,7 @@ pub use energy::{BodyFrame, MechanismEnergy};
 pub use model_input::{catalogue_options, mechanism_energy, realization_hints};
 pub use realize::{CounterweightParams, RealizationHints, SpringParams, Witness};
 pub use search::{
-    Arithmetic, Class, Decision, SearchOptions, SearchReport, Status, VariantResult, decide, search,
+    Arithmetic, Class, Decision, ElementKind, SearchOptions, SearchReport, Status, VariantResult,
+    decide, search,
 };
 pub use verify::{VERIFY_SAMPLES, VERIFY_TOL, Verification, VerificationSet};

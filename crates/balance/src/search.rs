@@ -71,24 +71,9 @@ pub enum Decision {
     Numeric,
 }
 
-/// Counterweights only, springs only, or both (the paper's three classes).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Class {
-    Counterweights,
-    Springs,
-    Hybrid,
-}
-
-impl Class {
-    pub fn name(self) -> &'static str {
-        match self {
-            Class::Counterweights => "counterweights",
-            Class::Springs => "springs",
-            Class::Hybrid => "hybrid",
-        }
-    }
-}
+/// Counterweights only, springs only, or both (the paper's three classes), and what an
+/// element is: the shared vocabulary.
+pub use counterpoise_vocabulary::{Class, ElementKind};
 
 /// One installed element of a variant, named for people.
 #[derive(Clone, Debug, Serialize)]
@@ -98,7 +83,7 @@ pub struct ElementRef {
     pub label: String,
     /// `counterweight` or `spring`.
     #[serde(rename = "type")]
-    pub kind: &'static str,
+    pub kind: ElementKind,
     /// Body names: one for a counterweight, two for a spring (`base` for the ground).
     pub bodies: Vec<String>,
 }
@@ -646,13 +631,13 @@ fn element_ref(
         Element::Counterweight { body, .. } => ElementRef {
             entry,
             label: e.label.clone(),
-            kind: "counterweight",
+            kind: ElementKind::Counterweight,
             bodies: vec![name(*body)],
         },
         Element::Spring { body, other, .. } => ElementRef {
             entry,
             label: e.label.clone(),
-            kind: "spring",
+            kind: ElementKind::Spring,
             bodies: vec![
                 name(*body),
                 match other {

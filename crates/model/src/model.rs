@@ -186,33 +186,8 @@ pub struct Actuator {
     pub ratio: f64,
 }
 
-/// A plane of a body frame to which balancing vectors are restricted.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Plane {
-    Xy,
-    Yz,
-    Xz,
-}
-
-impl Plane {
-    /// Indices of the two body axes spanning the plane.
-    pub fn axes(self) -> [usize; 2] {
-        match self {
-            Plane::Xy => [0, 1],
-            Plane::Yz => [1, 2],
-            Plane::Xz => [0, 2],
-        }
-    }
-
-    /// Index of the body axis normal to the plane.
-    pub fn normal(self) -> usize {
-        match self {
-            Plane::Xy => 2,
-            Plane::Yz => 0,
-            Plane::Xz => 1,
-        }
-    }
-}
+/// A plane of a body frame to which balancing vectors are restricted (the shared vocabulary).
+pub use counterpoise_vocabulary::Plane;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CounterweightShape {

@@ -6,34 +6,9 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Plane in which a counterweight offset or spring anchor lies, for polar display (Table 1);
-/// the same names as the case file's `plane`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Plane {
-    Xy,
-    Yz,
-    Xz,
-}
-
-impl Plane {
-    /// Indices of the (first, second) axes: the angle is atan2(second, first).
-    pub fn axes(self) -> (usize, usize) {
-        match self {
-            Plane::Xy => (0, 1),
-            Plane::Yz => (1, 2),
-            Plane::Xz => (0, 2),
-        }
-    }
-}
-
-/// `counterweight` or `spring`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ElementKind {
-    Counterweight,
-    Spring,
-}
+/// The plane of a counterweight offset or spring anchor (polar display, Table 1) and what an
+/// element is: the shared vocabulary.
+pub use counterpoise_vocabulary::{ElementKind, Plane};
 
 /// One installed element of a variant.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

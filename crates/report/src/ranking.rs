@@ -40,36 +40,8 @@ use thiserror::Error;
 /// Default tolerance of the equivalence, percentage points.
 pub const DEFAULT_TOLERANCE: f64 = 0.5;
 
-/// The paper's three classes of balanced variants.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Class {
-    Counterweights,
-    Springs,
-    Hybrid,
-}
-
-impl Class {
-    pub const ALL: [Class; 3] = [Class::Counterweights, Class::Springs, Class::Hybrid];
-
-    /// The machine name used in results.json and CSV.
-    pub fn name(self) -> &'static str {
-        match self {
-            Class::Counterweights => "counterweights",
-            Class::Springs => "springs",
-            Class::Hybrid => "hybrid",
-        }
-    }
-
-    /// The paper's wording, for reports.
-    pub fn title(self) -> &'static str {
-        match self {
-            Class::Counterweights => "Counterweights only",
-            Class::Springs => "Springs only",
-            Class::Hybrid => "Hybrid",
-        }
-    }
-}
+/// The paper's three classes of balanced variants (the shared vocabulary).
+pub use counterpoise_vocabulary::Class;
 
 /// Settings of the ranking.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

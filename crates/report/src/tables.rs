@@ -425,8 +425,8 @@ fn vector_cells(
     let length = v.iter().map(|x| x * x).sum::<f64>().sqrt();
     match plane {
         Some(p) => {
-            let (r, phi) = polar(v, p.axes());
-            let (a0, a1) = p.axes();
+            let [a0, a1] = p.axes();
+            let (r, phi) = polar(v, (a0, a1));
             let off = v[3 - a0 - a1];
             let len = if off.abs() > 1e-9 {
                 format!(

@@ -9,7 +9,7 @@ use counterpoise_dynamics::{Counterweight, Indicators, Spring, Variant};
 use counterpoise_model::Model;
 use counterpoise_report as report;
 use report::{
-    ActuatorSummary, ElementInfo, ElementKind, Evaluation, FreeDirection, JointPeak, OptimiserInfo,
+    ActuatorSummary, ElementInfo, Evaluation, FreeDirection, JointPeak, OptimiserInfo,
     PhysicalParameters, VariantRecord, VariantStatus,
 };
 
@@ -85,22 +85,6 @@ pub(crate) fn evaluation(
     }
 }
 
-fn class(c: counterpoise_balance::Class) -> report::Class {
-    match c {
-        counterpoise_balance::Class::Counterweights => report::Class::Counterweights,
-        counterpoise_balance::Class::Springs => report::Class::Springs,
-        counterpoise_balance::Class::Hybrid => report::Class::Hybrid,
-    }
-}
-
-fn plane(p: Option<counterpoise_model::Plane>) -> Option<report::Plane> {
-    p.map(|p| match p {
-        counterpoise_model::Plane::Xy => report::Plane::Xy,
-        counterpoise_model::Plane::Yz => report::Plane::Yz,
-        counterpoise_model::Plane::Xz => report::Plane::Xz,
-    })
-}
-
 /// One variant's record: the search's verdict, and the optimiser's for balanced ones.
 pub(crate) fn record(
     model: &Model,
@@ -114,11 +98,7 @@ pub(crate) fn record(
         .iter()
         .map(|e| ElementInfo {
             label: e.label.clone(),
-            kind: if e.kind == "spring" {
-                ElementKind::Spring
-            } else {
-                ElementKind::Counterweight
-            },
+            kind: e.kind,
             bodies: e.bodies.clone(),
         })
         .collect();
@@ -129,7 +109,7 @@ pub(crate) fn record(
         Status::Infeasible => VariantStatus::Infeasible,
         Status::Undecided => VariantStatus::Undecided,
     };
-    let mut r = VariantRecord::new(id, elements, class(v.class), status);
+    let mut r = VariantRecord::new(id, elements, v.class, status);
     r.reason = v.reason.clone();
     r.relations = v.relations.clone();
     r.free_directions = v
@@ -161,16 +141,12 @@ pub(crate) fn record(
         message: opt.reason.clone(),
     });
     let balancing = model.balancing.as_ref();
-    let cw_plane = plane(
-        balancing
-            .and_then(|b| b.counterweights.as_ref())
-            .and_then(|c| c.plane),
-    );
-    let spring_plane = plane(
-        balancing
-            .and_then(|b| b.springs.as_ref())
-            .and_then(|s| s.plane),
-    );
+    let cw_plane = balancing
+        .and_then(|b| b.counterweights.as_ref())
+        .and_then(|c| c.plane);
+    let spring_plane = balancing
+        .and_then(|b| b.springs.as_ref())
+        .and_then(|s| s.plane);
     r.parameters = Some(PhysicalParameters {
         counterweights: opt
             .counterweights

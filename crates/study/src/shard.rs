@@ -9,7 +9,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use counterpoise_balance::VariantResult;
+use counterpoise_balance::{ElementKind, VariantResult};
 use thiserror::Error;
 
 /// Shard `index` (1-based, as `SLURM_ARRAY_TASK_ID` runs over `--array=1-N`) of `count`.
@@ -84,7 +84,11 @@ pub struct CostFeatures {
 
 impl CostFeatures {
     pub fn of(v: &VariantResult) -> CostFeatures {
-        let springs = v.elements.iter().filter(|e| e.kind == "spring").count();
+        let springs = v
+            .elements
+            .iter()
+            .filter(|e| e.kind == ElementKind::Spring)
+            .count();
         CostFeatures {
             counterweights: v.elements.len() - springs,
             springs,
@@ -161,12 +165,13 @@ pub fn shard_variants(variants: &[VariantResult], spec: ShardSpec) -> Vec<usize>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ElementKind::{Counterweight, Spring};
     use counterpoise_balance::search::ElementRef;
     use counterpoise_balance::{Class, Status};
 
     /// A variant of the given element kinds and family dimension; the other fields are not
     /// read by the cost model.
-    fn variant(kinds: &[&'static str], nullity: usize, status: Status) -> VariantResult {
+    fn variant(kinds: &[ElementKind], nullity: usize, status: Status) -> VariantResult {
         let elements = kinds
             .iter()
             .enumerate()
@@ -199,7 +204,7 @@ mod tests {
         assert_eq!(cost(0, 1, 0), 12);
         assert_eq!(cost(0, 0, 1), 9);
         assert_eq!(cost(2, 1, 5), 8 + 12 + 4 + 5);
-        let hybrid = variant(&["counterweight", "spring", "spring"], 4, Status::Balanced);
+        let hybrid = variant(&[Counterweight, Spring, Spring], 4, Status::Balanced);
         assert_eq!(
             CostFeatures::of(&hybrid),
             CostFeatures {
@@ -215,10 +220,10 @@ mod tests {
         // costs 8 + 6 = 14 (index 0), 12 (index 2), 8 + 12 = 20 (index 3); index 1 is not
         // balanced. LPT into 2: 20 → shard 1, 14 → shard 2, 12 → shard 2.
         let variants = vec![
-            variant(&["counterweight"], 0, Status::Balanced),
-            variant(&["counterweight"], 0, Status::Infeasible),
-            variant(&["spring"], 0, Status::Balanced),
-            variant(&["spring", "spring", "spring"], 0, Status::Balanced),
+            variant(&[Counterweight], 0, Status::Balanced),
+            variant(&[Counterweight], 0, Status::Infeasible),
+            variant(&[Spring], 0, Status::Balanced),
+            variant(&[Spring, Spring, Spring], 0, Status::Balanced),
         ];
         let spec = |index| ShardSpec { index, count: 2 };
         assert_eq!(shard_variants(&variants, spec(1)), vec![3]);
