@@ -179,12 +179,7 @@ class Case:
     def from_file(cls, path: PathLike) -> "Case":
         """Loads a case file (JSON)."""
         path = os.fspath(path)
-        try:
-            with open(path, encoding="utf-8") as f:
-                text = f.read()
-        except OSError as e:
-            raise CounterpoiseError(f"cannot read {path}: {e.strerror}") from e
-        return cls(text, path)
+        return cls(_read(path), path)
 
     @classmethod
     def from_dict(cls, case: Mapping[str, Any]) -> "Case":
@@ -243,9 +238,14 @@ def load_case(source: Union[PathLike, Mapping[str, Any]]) -> Case:
 def import_urdf(path: PathLike, base: Optional[str] = None, tip: Optional[str] = None) -> Case:
     """A case from a URDF robot description, as ``counterpoise import-urdf`` writes it."""
     path = os.fspath(path)
+    urdf = _read(path)
+    return Case(_counterpoise.import_urdf(urdf, path, base, tip), path + " (imported)")
+
+
+def _read(path: str) -> str:
+    """A text file's contents, or CounterpoiseError naming the file (as the CLI does)."""
     try:
         with open(path, encoding="utf-8") as f:
-            urdf = f.read()
+            return f.read()
     except OSError as e:
         raise CounterpoiseError(f"cannot read {path}: {e.strerror}") from e
-    return Case(_counterpoise.import_urdf(urdf, path, base, tip), path + " (imported)")

@@ -14,6 +14,7 @@ use std::sync::atomic::AtomicBool;
 
 use counterpoise_model::{Case, Limits, Model};
 use counterpoise_report::RankingOptions;
+use counterpoise_study::error::with_causes;
 use counterpoise_study::{SearchSettings, Silent, Study, StudyError, StudyOptions, preflight};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
@@ -25,20 +26,6 @@ create_exception!(
     PyValueError,
     "A case, an option or a study that counterpoise refuses; the message names the field and the reason."
 );
-
-/// `e` as the command line prints it: the message, then each cause it does not already say.
-fn message(e: &dyn std::error::Error) -> String {
-    let mut text = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let more = c.to_string();
-        if !text.contains(&more) {
-            text = format!("{text}: {more}");
-        }
-        cause = c.source();
-    }
-    text
-}
 
 /// Runs `work` without the GIL on a worker thread sized like the command line's.
 fn detached<T: Send>(
@@ -57,7 +44,7 @@ fn detached<T: Send>(
     });
     match outcome {
         Ok(Ok(Ok(value))) => Ok(value),
-        Ok(Ok(Err(e))) => Err(CounterpoiseError::new_err(message(&e))),
+        Ok(Ok(Err(e))) => Err(CounterpoiseError::new_err(with_causes(&e))),
         Ok(Err(_)) => Err(CounterpoiseError::new_err(
             "internal error: the study panicked",
         )),
@@ -162,7 +149,7 @@ fn import_urdf(
     let options = counterpoise_urdf::ImportOptions { base, tip };
     py.detach(move || counterpoise_urdf::import(&urdf, &options))
         .map(|imported| imported.json)
-        .map_err(|e| CounterpoiseError::new_err(format!("{name}: {}", message(&e))))
+        .map_err(|e| CounterpoiseError::new_err(format!("{name}: {}", with_causes(&e))))
 }
 
 #[pymodule]

@@ -26,23 +26,9 @@ pub fn failed(e: StudyError) -> ExitCode {
     if let StudyError::Case { .. } | StudyError::Problems(_) = e {
         eprintln!("{e}");
     } else {
-        eprintln!("error: {}", with_causes(&e));
+        eprintln!("error: {}", counterpoise_study::error::with_causes(&e));
     }
     ExitCode::FAILURE
-}
-
-/// The error's message followed by each cause it does not already say.
-pub fn with_causes(e: &dyn std::error::Error) -> String {
-    let mut message = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let text = c.to_string();
-        if !message.contains(&text) {
-            message = format!("{message}: {text}");
-        }
-        cause = c.source();
-    }
-    message
 }
 
 /// Prints a command's text, or ends on its error.

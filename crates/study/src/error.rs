@@ -61,6 +61,21 @@ impl StudyError {
     }
 }
 
+/// The error's message followed by each cause it does not already say: what the command line
+/// prints after `error:`, and the Python module's exception message.
+pub fn with_causes(e: &dyn std::error::Error) -> String {
+    let mut message = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let text = c.to_string();
+        if !message.contains(&text) {
+            message = format!("{message}: {text}");
+        }
+        cause = c.source();
+    }
+    message
+}
+
 /// `Err(StudyError::Invalid(format!(…)))`, the library's `bail!`.
 macro_rules! invalid {
     ($($arg:tt)*) => {
@@ -71,3 +86,24 @@ pub(crate) use invalid;
 
 /// A study's result.
 pub type Result<T, E = StudyError> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cause the message already says is not repeated; one it does not say is appended.
+    #[test]
+    fn causes_are_said_once() {
+        let gone = std::io::Error::new(std::io::ErrorKind::NotFound, "gone");
+        let io = StudyError::io("cannot read case.json", gone);
+        assert_eq!(with_causes(&io), "cannot read case.json: gone");
+        #[derive(Debug, thiserror::Error)]
+        #[error("writing the shard")]
+        struct Outer(#[source] StudyError);
+        let outer = Outer(io);
+        assert_eq!(
+            with_causes(&outer),
+            "writing the shard: cannot read case.json: gone"
+        );
+    }
+}
