@@ -52,12 +52,12 @@ fn a_joint_idle_in_the_unbalanced_robot_counts_when_it_gets_loaded() {
     let dr = delta_r(&ub, &[200.0, 50.0], &[10.0, 10.0]).unwrap();
     assert!((dr - 25.0).abs() < 1e-12, "ΔR = {dr}");
     // The ranking's own function agrees (one definition).
-    let j = |name: &str, force: f64, moment: f64| counterpoise_report::JointReaction {
+    let j = |name: &str, force: f64, moment: f64| counterpoise_vocabulary::JointReaction {
         name: name.into(),
         force,
         moment,
     };
-    let report = counterpoise_report::delta_r(
+    let report = counterpoise_vocabulary::delta_r(
         &[j("J1", 200.0, 10.0), j("J2", 0.0, 10.0)],
         &[j("J1", 200.0, 10.0), j("J2", 50.0, 10.0)],
     )

@@ -58,7 +58,8 @@ pub mod decision;
 pub mod format;
 pub mod honest;
 pub mod html;
-pub mod indicators;
+/// The paper's indicators (Eqs. 15–21) are shared vocabulary: the optimiser chooses springs by ΔR.
+pub use counterpoise_vocabulary::indicators;
 pub mod labels;
 pub mod markdown;
 pub mod output;

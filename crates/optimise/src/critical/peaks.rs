@@ -172,7 +172,7 @@ pub(super) fn move_peaks(
 /// ΔR (paper Eqs. 17–21, percent) of a variant whose peak joint reactions are `force`, `moment`
 /// (one per joint, in the unbalanced indicators' joint order), against the unbalanced robot.
 ///
-/// There is one definition of ΔR in the workspace: [`counterpoise_report::delta_r`], which the
+/// There is one definition of ΔR in the workspace: [`counterpoise_vocabulary::delta_r`], which the
 /// ranking uses. Calling it here means the springs are chosen by the very quantity they are
 /// ranked by. In particular a joint that carries no load in the unbalanced robot counts with
 /// its weighted term `γ·ΔF = (F − F_UB)/Σ F_UB · 100` (the continuous extension of Eq. 19 at
@@ -180,7 +180,7 @@ pub(super) fn move_peaks(
 ///
 /// `None` when the unbalanced robot has no joint reactions or a value is not finite.
 pub fn delta_r(unbalanced: &Indicators, force: &[f64], moment: &[f64]) -> Option<f64> {
-    use counterpoise_report::JointReaction;
+    use counterpoise_vocabulary::JointReaction;
     if unbalanced.joints.is_empty()
         || force.len() != unbalanced.joints.len()
         || moment.len() != unbalanced.joints.len()
@@ -206,7 +206,7 @@ pub fn delta_r(unbalanced: &Indicators, force: &[f64], moment: &[f64]) -> Option
             moment,
         })
         .collect();
-    counterpoise_report::delta_r(&reference, &variant)
+    counterpoise_vocabulary::delta_r(&reference, &variant)
         .ok()
         .map(|d| d.value)
 }
