@@ -13,8 +13,8 @@ use std::path::Path;
 use common::run_reduced_palletizer;
 use counterpoise_report::{
     Class, CounterweightParams, ElementInfo, ElementKind, Evaluation, JointPeak,
-    PhysicalParameters, RankingOptions, RunMetadata, RunResults, SpringParams, VariantRecord,
-    VariantStatus, read_results,
+    PhysicalParameters, RankingOptions, RunMetadata, RunResults, SpringParams, Status,
+    VariantRecord, read_results,
 };
 
 /// Idle element labels of a variant by the rule, from the raw fields.
@@ -125,7 +125,7 @@ fn sample() -> RunResults {
                 bodies: vec!["a".into(), "base".into()],
             }))
             .collect();
-        let mut v = VariantRecord::new(id, elements, class, VariantStatus::Feasible);
+        let mut v = VariantRecord::new(id, elements, class, Status::Feasible);
         let peaks = p
             .springs
             .iter()

@@ -21,45 +21,9 @@ use crate::relations::{
 use crate::verify::{Verification, VerificationSet};
 use counterpoise_symbolic::RefArith;
 
-/// What the search concluded about a variant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Status {
-    /// Verified physical parameters exist, and every element carries part of the load.
-    Balanced,
-    /// Verified physical parameters exist, but some element can only idle: it contributes no
-    /// energy in any balancing solution (a spring anchored on a joint axis, a counterweight on a
-    /// fixed point). The variant is really a smaller one plus idle parts; it is realizable.
-    Degenerate,
-    /// Lifted parameters exist but no physical ones can: a certificate is given (a mass or
-    /// stiffness forced to zero or below, no positive solution, an impossible rank-one spring).
-    Unrealizable,
-    /// `A_S x = −b` has no solution: no parameters balance this variant.
-    Infeasible,
-    /// Not decided: a floating-point test was ambiguous, or no witness was found and no proof
-    /// either (reason given). Never a verdict.
-    Undecided,
-}
-
-impl Status {
-    pub const ALL: [Status; 5] = [
-        Status::Balanced,
-        Status::Degenerate,
-        Status::Unrealizable,
-        Status::Infeasible,
-        Status::Undecided,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Status::Balanced => "balanced",
-            Status::Degenerate => "degenerate",
-            Status::Unrealizable => "unrealizable",
-            Status::Infeasible => "infeasible",
-            Status::Undecided => "undecided",
-        }
-    }
-}
+/// What the search concluded about a variant: the shared status (the search gives
+/// [`Status::SEARCH_VERDICTS`]).
+pub use counterpoise_vocabulary::Status;
 
 /// Which arithmetic decided a variant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -691,7 +655,7 @@ mod tests {
     #[test]
     fn status_and_class_names_are_the_serialized_ones() {
         let serialized = |v: serde_json::Value| v.as_str().unwrap().to_string();
-        let statuses: Vec<String> = Status::ALL
+        let statuses: Vec<String> = Status::SEARCH_VERDICTS
             .iter()
             .map(|s| serialized(serde_json::to_value(s).unwrap()))
             .collect();
@@ -705,7 +669,7 @@ mod tests {
                 "undecided"
             ]
         );
-        for (status, name) in Status::ALL.iter().zip(&statuses) {
+        for (status, name) in Status::SEARCH_VERDICTS.iter().zip(&statuses) {
             assert_eq!(status.name(), name);
         }
         for (class, name) in [

@@ -21,7 +21,7 @@ use counterpoise_symbolic::Rational;
 use nalgebra::{DVector, Vector3};
 
 fn counts(report: &SearchReport) -> [usize; 5] {
-    Status::ALL.map(|s| report.count(s))
+    Status::SEARCH_VERDICTS.map(|s| report.count(s))
 }
 
 fn realizable(v: &VariantResult) -> bool {

@@ -9,18 +9,9 @@ use crate::clarabel_map::ConicStatus;
 use crate::problem::Objective;
 use crate::verify::VerificationReport;
 
-/// `feasible`, `discarded` (paper Proc-6) or `undecided`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum OptimisedStatus {
-    Feasible,
-    /// Certified: the relaxation of the exact constraints is infeasible, or the optimised
-    /// parameters were verified to violate a peak limit over all tasks.
-    Discarded,
-    /// No parameters within the bounds were found, but none were proved impossible either
-    /// (a numerical failure, or a local search that gave up): the reason says which.
-    Undecided,
-}
+/// The optimiser's verdict is the shared status: `Feasible`, `Discarded` (paper Proc-6) or
+/// `Undecided`.
+pub use counterpoise_vocabulary::Status;
 
 /// An optimised counterweight (SI).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -98,7 +89,7 @@ pub struct OptimisedVariant {
     /// Element labels (`m4`, `K43`).
     pub elements: Vec<String>,
     pub class: Class,
-    pub status: OptimisedStatus,
+    pub status: Status,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
     pub objective_kind: Objective,
@@ -134,7 +125,7 @@ pub struct OptimisedVariant {
 
 impl OptimisedVariant {
     pub fn is_feasible(&self) -> bool {
-        self.status == OptimisedStatus::Feasible
+        self.status == Status::Feasible
     }
 }
 

@@ -9,7 +9,7 @@
 
 mod common;
 
-use counterpoise_optimise::{Context, OptimiseOptions, OptimisedStatus};
+use counterpoise_optimise::{Context, OptimiseOptions, Status};
 
 fn pendulum_with_spring(overrides: serde_json::Value) -> serde_json::Value {
     let mut json = common::case_json("pendulum.json");
@@ -28,7 +28,7 @@ fn a_fixed_anchor_and_a_box_are_met_and_the_spring_balances() {
     let model = common::model(&json);
     let (_, results) = common::optimise(&model, &[&["K10"]], &OptimiseOptions::default());
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let s = &v.springs[0];
     for (k, want) in [0.1, 0.0, 0.0].iter().enumerate() {
         assert!((s.anchor_a[k] - want).abs() <= 1e-9, "a = {:?}", s.anchor_a);
@@ -53,7 +53,7 @@ fn a_half_space_keeps_the_anchor_on_the_link() {
     let model = common::model(&json);
     let (_, results) = common::optimise(&model, &[&["K10"]], &OptimiseOptions::default());
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let s = &v.springs[0];
     assert!(s.anchor_a[0] >= 0.2 - 1e-9, "a = {:?}", s.anchor_a);
     assert!(s.anchor_b[1] <= 0.25 + 1e-9, "b = {:?}", s.anchor_b);

@@ -16,7 +16,7 @@
 
 mod common;
 
-use counterpoise_optimise::{OptimiseOptions, OptimisedStatus, OptimisedVariant};
+use counterpoise_optimise::{OptimiseOptions, OptimisedVariant, Status};
 
 const G: f64 = 9.81;
 /// M g L/2 of the rod, N·m.
@@ -78,7 +78,7 @@ fn an_anchor_bound_short_by_a_hand_computed_margin_is_proved_impossible() {
         &["K10"],
         &OptimiseOptions::default(),
     );
-    assert_eq!(v.status, OptimisedStatus::Discarded, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Discarded, "{:?}", v.reason);
     let reason = v.reason.unwrap();
     assert!(reason.contains("proved by splitting"), "{reason}");
     assert!(reason.contains("K10: K ∈ [1, 100] N/m"), "{reason}");
@@ -96,7 +96,7 @@ fn a_realization_just_inside_the_bound_is_found() {
         &["K10"],
         &OptimiseOptions::default(),
     );
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let (cross, dot) = spring_moments(&v);
     assert!((cross - MOMENT).abs() <= 1e-9 * MOMENT, "K (a×b) = {cross}");
     assert!(dot.abs() <= 1e-9 * MOMENT, "K a·b = {dot}");
@@ -158,12 +158,7 @@ fn the_hybrid_optimum_known_in_closed_form_is_reached_from_every_start() {
             ..OptimiseOptions::default()
         };
         let v = run(&json, &["m1", "K10"], &options);
-        assert_eq!(
-            v.status,
-            OptimisedStatus::Feasible,
-            "seed {seed}: {:?}",
-            v.reason
-        );
+        assert_eq!(v.status, Status::Feasible, "seed {seed}: {:?}", v.reason);
         let value = v.objective.unwrap();
         let bound = v.lower_bound.unwrap();
         assert!(v.gap.unwrap() <= 1e-3, "seed {seed}: gap {:?}", v.gap);
@@ -208,7 +203,7 @@ fn a_hybrid_with_an_anchor_floor_reaches_the_hand_optimum() {
         ..OptimiseOptions::default()
     };
     let v = run(&json, &["m1", "K10"], &options);
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let value = v.objective.unwrap();
     assert!(v.gap.unwrap() <= 1e-3, "gap {:?}", v.gap);
     assert!(v.lower_bound.unwrap() <= f_star * (1.0 + 1e-9));

@@ -3,7 +3,7 @@
 
 mod common;
 
-use counterpoise_optimise::{Context, OptimiseOptions, OptimisedStatus};
+use counterpoise_optimise::{Context, OptimiseOptions, Status};
 
 fn pendulum(overrides: serde_json::Value) -> serde_json::Value {
     let mut json = common::case_json("pendulum.json");
@@ -23,7 +23,7 @@ fn a_fixed_distance_is_met_exactly() {
     let model = common::model(&json);
     let (_, results) = common::optimise(&model, &[&["m1"]], &OptimiseOptions::default());
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let c = &v.counterweights[0];
     assert!(
         (c.radius - 0.125).abs() <= 1e-9 * 0.125,
@@ -39,7 +39,7 @@ fn a_fixed_mass_is_met_exactly() {
     let model = common::model(&json);
     let (_, results) = common::optimise(&model, &[&["m1"]], &OptimiseOptions::default());
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     assert!((v.counterweights[0].mass - 5.0).abs() <= 1e-9 * 5.0);
     assert!((v.counterweights[0].radius - 0.2).abs() <= 1e-9);
 }

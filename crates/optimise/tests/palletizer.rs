@@ -8,7 +8,7 @@ mod common;
 
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{EvaluateOptions, Indicators, evaluate_grid};
-use counterpoise_optimise::{OptimiseOptions, OptimisedStatus};
+use counterpoise_optimise::{OptimiseOptions, Status};
 
 const SETS: [&[&str]; 11] = [
     &["m4", "m5"],
@@ -104,7 +104,7 @@ fn the_papers_eleven_sets() {
             }
         }
         match v.status {
-            OptimisedStatus::Feasible => {
+            Status::Feasible => {
                 let obj = v.objective.unwrap();
                 let ind = v.indicators.as_ref().unwrap();
                 // the objective is RMS* of the variant's own indicators over all tasks
@@ -149,9 +149,10 @@ fn the_papers_eleven_sets() {
                     assert!(!ind.joints.is_empty());
                 }
             }
-            OptimisedStatus::Discarded | OptimisedStatus::Undecided => {
+            Status::Discarded | Status::Undecided => {
                 assert!(v.reason.as_ref().is_some_and(|r| !r.is_empty()));
             }
+            other => panic!("the optimiser gave {other:?}, not one of its verdicts"),
         }
     }
     assert!(shortcuts > 0, "no pass kept its recovered point");
@@ -357,7 +358,7 @@ fn free_parameter_intervals_match_the_bounds_by_hand() {
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * b.abs().max(1.0);
     let mut checked = 0;
     for v in &results {
-        assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.elements);
+        assert_eq!(v.status, Status::Feasible, "{:?}", v.elements);
         let cw = |label: &str| v.counterweights.iter().find(|c| c.label == label);
         let (m3, mu3) = {
             let c = cw("m3").unwrap();
@@ -424,7 +425,7 @@ fn the_spring_realization_recovers_by_more_starts_and_by_moving_the_counterweigh
     for v in retried.iter().chain(&joint) {
         assert_eq!(
             v.status,
-            OptimisedStatus::Feasible,
+            Status::Feasible,
             "{:?}: {:?}",
             v.elements,
             v.reason
@@ -448,7 +449,7 @@ fn a_hybrid_whose_relaxed_anchor_is_inside_its_floor_closes_its_gap() {
     let (_, results) =
         common::optimise(&model, &[&["m3", "m5", "K42"]], &OptimiseOptions::default());
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     assert!(v.gap.unwrap() <= 1e-3, "gap {:?}", v.gap);
     assert!(v.objective.unwrap() < 12.43, "objective {:?}", v.objective);
     assert!(v.residual.unwrap() <= 1e-9);
@@ -471,7 +472,7 @@ fn a_hybrid_whose_boxes_propose_poor_designs_is_descended_to_a_better_one() {
         &OptimiseOptions::default(),
     );
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let (value, bound) = (v.objective.unwrap(), v.lower_bound.unwrap());
     assert!(value <= 11.849, "objective {value}");
     assert!(bound <= value, "bound {bound} above the design {value}");

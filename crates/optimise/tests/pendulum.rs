@@ -8,7 +8,7 @@
 
 mod common;
 
-use counterpoise_optimise::{Objective, OptimiseOptions, OptimisedStatus};
+use counterpoise_optimise::{Objective, OptimiseOptions, Status};
 
 const RATIO: f64 = 0.01;
 const M_ROD: f64 = 2.0;
@@ -78,7 +78,7 @@ fn run(json: &serde_json::Value) -> counterpoise_optimise::OptimisedVariant {
 #[test]
 fn interior_optimum_matches_scan() {
     let v = run(&case([1.0, 100.0], [0.0, 0.5], None, DENSITY));
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let (m_star, f_star) = scan(2.0, 100.0, DENSITY);
     let m = v.counterweights[0].mass;
     let obj = v.objective.unwrap();
@@ -100,7 +100,7 @@ fn interior_optimum_matches_scan() {
 #[test]
 fn active_mass_bound() {
     let v = run(&case([1.0, 8.0], [0.0, 0.5], None, DENSITY));
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let (m_star, f_star) = scan(2.0, 8.0, DENSITY);
     assert!((m_star - 8.0).abs() < 1e-9);
     let m = v.counterweights[0].mass;
@@ -116,7 +116,7 @@ fn active_mass_bound() {
 fn active_radius_bound() {
     // |r| ≤ 0.05 m ⇒ m ≥ 20 kg, above the unconstrained optimum (≈ 16 kg with τ = 0.5).
     let v = run(&case([1.0, 100.0], [0.0, 0.05], None, DENSITY));
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let (_, f_star) = scan(20.0, 100.0, DENSITY);
     let c = &v.counterweights[0];
     assert!(c.radius <= 0.05 * (1.0 + 1e-9), "radius {}", c.radius);
@@ -150,7 +150,7 @@ fn peak_limit_at_the_smallest_achievable_peak() {
     let min_peak = RATIO * inertia(m_star, DENSITY) * accel_peak();
     let above = min_peak * 1.001;
     let v = run(&case([1.0, 100.0], [0.0, 0.5], Some(above), DENSITY));
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let peak = v.indicators.as_ref().unwrap().actuators[0].cpt_peak;
     assert!(
         min_peak * (1.0 - 1e-9) <= peak && peak <= above,
@@ -164,7 +164,7 @@ fn peak_limit_at_the_smallest_achievable_peak() {
 
     let below = min_peak * 0.999;
     let tight = run(&case([1.0, 100.0], [0.0, 0.5], Some(below), DENSITY));
-    assert_eq!(tight.status, OptimisedStatus::Discarded);
+    assert_eq!(tight.status, Status::Discarded);
     let reason = tight.reason.unwrap();
     assert!(
         reason.contains("peak") || reason.contains("infeasible"),
@@ -177,7 +177,7 @@ fn peak_limit_at_the_smallest_achievable_peak() {
 fn infeasible_bounds_are_discarded() {
     // m ≤ 5 kg and |r| ≤ 0.1 m cannot give m·r = 1 kg·m.
     let v = run(&case([1.0, 5.0], [0.0, 0.1], None, DENSITY));
-    assert_eq!(v.status, OptimisedStatus::Discarded);
+    assert_eq!(v.status, Status::Discarded);
     let reason = v.reason.unwrap();
     // The binding bound in the designer's words (m·r = 1 kg·m: 10 kg at 0.1 m, or 0.2 m at 5 kg).
     assert!(reason.contains("m1 would need"), "{reason}");
@@ -193,7 +193,7 @@ fn minimax_on_one_actuator_equals_rms_optimum() {
     };
     let (_, results) = common::optimise(&model, &[&["m1"]], &options);
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let (_, f_star) = scan(2.0, 100.0, DENSITY);
     // one actuator: QTR = RMS* = the same function of m
     assert!((v.objective.unwrap() - f_star).abs() <= 1e-4 * f_star);

@@ -13,7 +13,7 @@ mod common;
 use counterpoise_dynamics::Indicators;
 use counterpoise_dynamics::params::{Counterweight, ParameterSet, Variant};
 use counterpoise_dynamics::{EvaluateOptions, evaluate_grid};
-use counterpoise_optimise::{Objective, OptimiseOptions, OptimisedStatus};
+use counterpoise_optimise::{Objective, OptimiseOptions, Status};
 
 const M1: f64 = 4.0;
 const C1: f64 = 0.4;
@@ -131,7 +131,7 @@ fn one_free_mass_matches_a_fine_scan() {
     let model = common::model(&json);
     let (_, results) = common::optimise(&model, &[&["m1", "m2"]], &OptimiseOptions::default());
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let m1 = v.counterweights.iter().find(|c| c.label == "m1").unwrap();
     assert!(
         (m1.mass - M1_FIXED).abs() <= 1e-9 * M1_FIXED,
@@ -179,7 +179,7 @@ fn active_peak_limit_is_respected() {
     let model = common::model(&json);
     let (_, results) = common::optimise(&model, &[&["m1", "m2"]], &OptimiseOptions::default());
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let peak = v.indicators.as_ref().unwrap().actuators[0].cpt_peak;
     assert!(
         peak <= limit * (1.0 + 1e-9),
@@ -221,7 +221,7 @@ fn minimax_with_two_actuators_matches_a_qtr_scan() {
     };
     let (_, results) = common::optimise(&model, &[&["m1", "m2"]], &options);
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let lo = 0.5_f64.max((M2 * C2 + TOOL * L2) / 2.0);
     let (m_star, q_star) = fine_scan(&model, lo, 40.0, None, qtr);
     let obj = v.objective.unwrap();
@@ -259,7 +259,7 @@ fn an_unsolved_relaxation_still_reaches_the_optimum_without_a_bound() {
     };
     let (_, results) = common::optimise(&model, &[&["m1", "m2"]], &options);
     let v = &results[0];
-    assert_eq!(v.status, OptimisedStatus::Feasible, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     assert_eq!(v.lower_bound, None);
     assert_eq!(v.gap, None);
     for it in &v.iterations {
@@ -290,7 +290,7 @@ fn infeasibility_is_discarded_only_when_proved() {
     let (_, proved) = common::optimise(&model, &[&["m1", "m2"]], &OptimiseOptions::default());
     assert_eq!(
         proved[0].status,
-        OptimisedStatus::Discarded,
+        Status::Discarded,
         "{:?}",
         proved[0].reason
     );
@@ -300,7 +300,7 @@ fn infeasibility_is_discarded_only_when_proved() {
     };
     let (_, unproved) = common::optimise(&model, &[&["m1", "m2"]], &options);
     let v = &unproved[0];
-    assert_eq!(v.status, OptimisedStatus::Undecided, "{:?}", v.reason);
+    assert_eq!(v.status, Status::Undecided, "{:?}", v.reason);
     let reason = v.reason.as_deref().unwrap();
     assert!(
         reason.starts_with("no parameters meeting every bound were found from 3 starting points"),

@@ -383,7 +383,7 @@ fn join_steps(steps: &[String]) -> String {
 mod tests {
     use super::*;
     use crate::practical::PracticalFigures;
-    use crate::results::{ElementInfo, ElementKind, VariantStatus};
+    use crate::results::{ElementInfo, ElementKind, Status};
 
     /// A ranked variant with hand-chosen indicators and practical figures.
     fn v(
@@ -406,7 +406,7 @@ mod tests {
                 bodies: vec![],
             })
             .collect();
-        let mut r = VariantRecord::new(id, elements, class, VariantStatus::Feasible);
+        let mut r = VariantRecord::new(id, elements, class, Status::Feasible);
         r.name = Some(format!("SB{rank}"));
         r.rank = Some(rank);
         r.dqtr = Some(dqtr);

@@ -7,7 +7,7 @@ use std::fmt::Write;
 use crate::charts::{self, Chart, Section};
 use crate::format::{escape_html as esc, value};
 use crate::partial::{self, PartialBalancing};
-use crate::results::{RunResults, VariantStatus};
+use crate::results::{RunResults, Status};
 use crate::tables::{self, Table};
 
 const CSS: &str = r#"
@@ -527,24 +527,13 @@ pub fn not_ranked_summary(r: &RunResults) -> String {
     let parts: Vec<String> = r
         .counts
         .iter()
-        .filter(|c| {
-            c.total > 0
-                && !matches!(
-                    c.status,
-                    VariantStatus::Feasible | VariantStatus::Infeasible
-                )
-        })
+        .filter(|c| c.total > 0 && !matches!(c.status, Status::Feasible | Status::Infeasible))
         .map(|c| format!("{} {} ({})", c.total, c.status.name(), c.status.meaning()))
         .collect();
     let total: usize = r
         .counts
         .iter()
-        .filter(|c| {
-            !matches!(
-                c.status,
-                VariantStatus::Feasible | VariantStatus::Infeasible
-            )
-        })
+        .filter(|c| !matches!(c.status, Status::Feasible | Status::Infeasible))
         .map(|c| c.total)
         .sum();
     format!("{total} variants not ranked: {}", parts.join("; "))

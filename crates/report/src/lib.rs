@@ -25,7 +25,7 @@
 //! let mut results = RunResults::new(metadata, serde_json::json!({}), eval(10.0));
 //! let element = ElementInfo { label: "m1".into(), kind: ElementKind::Counterweight,
 //!                             bodies: vec!["arm".into()] };
-//! let mut v = VariantRecord::new(0, vec![element], Class::Counterweights, VariantStatus::Feasible);
+//! let mut v = VariantRecord::new(0, vec![element], Class::Counterweights, Status::Feasible);
 //! v.evaluation = Some(eval(4.0));
 //! results.variants.push(v);
 //! results.finalize(&RankingOptions::default())?;        // ΔQTR = −60 %, rank 1
@@ -93,7 +93,7 @@ pub use results::{
     ActuatorSummary, CounterweightParams, CriticalTask, Curve, ElementInfo, ElementKind,
     EnergyChart, Evaluation, FreeDirection, JointPeak, OptimiserInfo, PathMechanism, PathRun,
     PathSimulation, PathStat, PhaseTiming, PhysicalParameters, Plane, RankingInfo, ResultsError,
-    RunMetadata, RunResults, SCHEMA_VERSION, SpringParams, StatusCount, TaskRef, TorqueChart,
-    VariantRecord, VariantStatus,
+    RunMetadata, RunResults, SCHEMA_VERSION, SpringParams, Status, StatusCount, TaskRef,
+    TorqueChart, VariantRecord,
 };
 pub use schematic::{DrawnBody, DrawnCounterweight, DrawnJoint, DrawnSpring, Schematic};

@@ -29,7 +29,7 @@ pub use crate::parameters::{
     SpringParams,
 };
 pub use crate::variant::{
-    ActuatorSummary, Evaluation, JointPeak, OptimiserInfo, TaskRef, VariantRecord, VariantStatus,
+    ActuatorSummary, Evaluation, JointPeak, OptimiserInfo, Status, TaskRef, VariantRecord,
 };
 
 /// Version of the results.json layout.
@@ -103,7 +103,7 @@ pub struct RunMetadata {
 /// Number of variants with one status, per class.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StatusCount {
-    pub status: VariantStatus,
+    pub status: Status,
     pub counterweights: usize,
     pub springs: usize,
     pub hybrid: usize,
@@ -300,7 +300,7 @@ impl RunResults {
             v.rank = None;
             v.class_rank = None;
             v.tie_broken_by_label = false;
-            if v.status != VariantStatus::Feasible {
+            if v.status != Status::Feasible {
                 continue;
             }
             let label = v.label();
@@ -387,7 +387,7 @@ impl RunResults {
         let moving_mass = self.moving_mass;
         for v in &mut self.variants {
             v.idle = match (&v.parameters, v.status) {
-                (Some(p), VariantStatus::Feasible) => {
+                (Some(p), Status::Feasible) => {
                     idle_elements(p, v.practical.as_ref(), moving_mass, g)
                 }
                 _ => Vec::new(),
@@ -570,12 +570,12 @@ impl RunResults {
 }
 
 fn count_statuses(variants: &[VariantRecord]) -> Vec<StatusCount> {
-    let mut map: BTreeMap<VariantStatus, [usize; 3]> = BTreeMap::new();
+    let mut map: BTreeMap<Status, [usize; 3]> = BTreeMap::new();
     for v in variants {
         let c = Class::ALL.iter().position(|&c| c == v.class).unwrap_or(0);
         map.entry(v.status).or_default()[c] += 1;
     }
-    VariantStatus::ALL
+    Status::STUDY_VERDICTS
         .iter()
         .map(|&status| {
             let n = map.get(&status).copied().unwrap_or_default();

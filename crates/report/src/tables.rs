@@ -3,7 +3,7 @@
 
 use crate::format::{angle, compact, fixed, percent, polar, seconds, task, value};
 use crate::honest::on_bound;
-use crate::results::{PathSimulation, RunResults, VariantRecord, VariantStatus};
+use crate::results::{PathSimulation, RunResults, Status, VariantRecord};
 use crate::springspec::SpringSpec;
 
 /// One cell: text, whether it is a number (right-aligned) and whether it is prose that may wrap
@@ -607,12 +607,11 @@ pub fn joint_reactions_of(_r: &RunResults, variants: &[&VariantRecord]) -> Table
 /// Balanced variants that were not ranked, and why (infeasible ones are only counted).
 pub fn not_ranked(r: &RunResults) -> Table {
     let mut t = Table::new(&["Id", "Elements", "Class", "Status", "Reason"]);
-    for v in r.variants.iter().filter(|v| {
-        !matches!(
-            v.status,
-            VariantStatus::Feasible | VariantStatus::Infeasible
-        )
-    }) {
+    for v in r
+        .variants
+        .iter()
+        .filter(|v| !matches!(v.status, Status::Feasible | Status::Infeasible))
+    {
         t.push(
             vec![
                 Cell::num(v.id.to_string()),

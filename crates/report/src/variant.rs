@@ -15,64 +15,8 @@ use crate::ranking::Class;
 /// crate).
 pub type TaskRef = [usize; 2];
 
-/// What became of a variant (the search's and the optimiser's verdicts combined).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum VariantStatus {
-    /// Balanced, optimised within bounds and re-evaluated: ranked.
-    Feasible,
-    /// Balanced, but the optimiser found no parameters within the bounds/peak limits.
-    Discarded,
-    /// Balanced in lifted parameters, but no physical parameters exist.
-    Unrealizable,
-    /// Realizable, but some element can only idle (it contributes no energy in any balancing
-    /// solution): really a smaller variant plus idle parts, not optimised.
-    Degenerate,
-    /// The search or the optimiser could not decide.
-    Undecided,
-    /// No parameters balance it.
-    Infeasible,
-}
-
-impl VariantStatus {
-    pub const ALL: [VariantStatus; 6] = [
-        VariantStatus::Feasible,
-        VariantStatus::Discarded,
-        VariantStatus::Unrealizable,
-        VariantStatus::Degenerate,
-        VariantStatus::Undecided,
-        VariantStatus::Infeasible,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            VariantStatus::Feasible => "feasible",
-            VariantStatus::Discarded => "discarded",
-            VariantStatus::Unrealizable => "unrealizable",
-            VariantStatus::Degenerate => "degenerate",
-            VariantStatus::Undecided => "undecided",
-            VariantStatus::Infeasible => "infeasible",
-        }
-    }
-
-    /// One line for the counts table.
-    pub fn meaning(self) -> &'static str {
-        match self {
-            VariantStatus::Feasible => "balanced exactly, parameters within bounds; ranked",
-            VariantStatus::Discarded => {
-                "balanced, but no parameters satisfy the bounds and peak limits"
-            }
-            VariantStatus::Unrealizable => {
-                "balanced in lifted parameters, no physical parameters exist"
-            }
-            VariantStatus::Degenerate => {
-                "realizable, but an element can only idle (a smaller variant)"
-            }
-            VariantStatus::Undecided => "the search or optimiser could not decide",
-            VariantStatus::Infeasible => "no parameters balance the mechanism",
-        }
-    }
-}
+/// What became of a variant: the shared status, from the search's verdict to the study's.
+pub use counterpoise_vocabulary::Status;
 
 /// RMS and peak motor torque of one actuator on its critical tasks.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -163,7 +107,7 @@ pub struct VariantRecord {
     pub id: usize,
     pub elements: Vec<ElementInfo>,
     pub class: Class,
-    pub status: VariantStatus,
+    pub status: Status,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
     /// Balance relations in readable form (balanced variants).
@@ -216,7 +160,7 @@ pub struct VariantRecord {
 
 impl VariantRecord {
     /// A record with only the search's fields; the rest default to empty.
-    pub fn new(id: usize, elements: Vec<ElementInfo>, class: Class, status: VariantStatus) -> Self {
+    pub fn new(id: usize, elements: Vec<ElementInfo>, class: Class, status: Status) -> Self {
         VariantRecord {
             id,
             elements,

@@ -96,7 +96,7 @@ fn feasible(id: usize, labels: &[&str], class: Class, e: Evaluation) -> VariantR
         id,
         labels.iter().map(|l| element(l)).collect(),
         class,
-        VariantStatus::Feasible,
+        Status::Feasible,
     );
     v.parameters = Some(params(labels));
     // Every spring stretched to at most 0.8 m: 5669 N/m · 0.8 m = 4535.2 N.
@@ -203,7 +203,7 @@ fn sample() -> RunResults {
         21,
         vec![element("m4"), element("K42")],
         Class::Hybrid,
-        VariantStatus::Discarded,
+        Status::Discarded,
     );
     d.reason = Some("mass 620 kg > bound 500 kg".into());
     r.variants.push(d);
@@ -211,7 +211,7 @@ fn sample() -> RunResults {
         22,
         vec![element("K52")],
         Class::Springs,
-        VariantStatus::Unrealizable,
+        Status::Unrealizable,
     );
     u.reason = Some("K·W ≠ α·βᵀ <unrealizable>".into());
     r.variants.push(u);
@@ -219,19 +219,19 @@ fn sample() -> RunResults {
         0,
         vec![element("m1")],
         Class::Counterweights,
-        VariantStatus::Infeasible,
+        Status::Infeasible,
     ));
     r.variants.push(VariantRecord::new(
         1,
         vec![element("m2")],
         Class::Counterweights,
-        VariantStatus::Infeasible,
+        Status::Infeasible,
     ));
     let mut g = VariantRecord::new(
         2,
         vec![element("m3"), element("m4")],
         Class::Counterweights,
-        VariantStatus::Degenerate,
+        Status::Degenerate,
     );
     g.reason = Some("m3 = 0".into());
     r.variants.push(g);
@@ -239,7 +239,7 @@ fn sample() -> RunResults {
         30,
         vec![element("K21")],
         Class::Springs,
-        VariantStatus::Undecided,
+        Status::Undecided,
     ));
     r
 }
@@ -348,9 +348,9 @@ fn finalize_computes_indicators_and_ranks() {
     assert!(by_id(21).rank.is_none() && by_id(21).dqtr.is_none());
     // Counts.
     let count = |s| r.counts.iter().find(|c| c.status == s).unwrap().total;
-    assert_eq!(count(VariantStatus::Feasible), 5);
-    assert_eq!(count(VariantStatus::Infeasible), 2);
-    assert_eq!(count(VariantStatus::Discarded), 1);
+    assert_eq!(count(Status::Feasible), 5);
+    assert_eq!(count(Status::Infeasible), 2);
+    assert_eq!(count(Status::Discarded), 1);
     assert_eq!(
         r.counts.iter().map(|c| c.total).sum::<usize>(),
         r.variants.len()
@@ -553,7 +553,7 @@ fn regenerate_rejects_other_schema_versions() {
 fn empty_run_renders() {
     // No feasible variant, no joints, no curves: still a valid report.
     let mut r = sample();
-    r.variants.retain(|v| v.status != VariantStatus::Feasible);
+    r.variants.retain(|v| v.status != Status::Feasible);
     r.unbalanced.joints.clear();
     r.finalize(&RankingOptions::default()).unwrap();
     let html = counterpoise_report::html::render(&r);

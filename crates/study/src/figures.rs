@@ -6,7 +6,7 @@ use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{Counterweight, Spring, Variant, task_series_with};
 use counterpoise_model::Model;
 use counterpoise_report as report;
-use report::{RunResults, VariantStatus};
+use report::{RunResults, Status};
 
 use crate::error::{Result, StudyError};
 use crate::record::dynamics_variant;
@@ -232,7 +232,7 @@ pub fn add_practical_figures(
     let kinematics = counterpoise_model::Kinematics::new(model);
     let moving_mass = results.moving_mass;
     for v in results.variants.iter_mut() {
-        if v.status != VariantStatus::Feasible {
+        if v.status != Status::Feasible {
             continue;
         }
         let Some(p) = &v.parameters else { continue };

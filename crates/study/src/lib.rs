@@ -12,14 +12,14 @@
 //! ```
 //! use std::sync::atomic::AtomicBool;
 //! use counterpoise_study::{Silent, Study, StudyOptions, load_case};
-//! use counterpoise_report::VariantStatus;
+//! use counterpoise_report::Status;
 //!
 //! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../cases/two_link.json");
 //! let model = load_case(path.as_ref()).expect("a valid case");
 //! let study = Study::new(&model, StudyOptions::default()).expect("within the limits");
 //! let outcome = study.run(&mut Silent, &AtomicBool::new(false)).expect("a finished study");
 //! let best = outcome.results.variants.iter().find(|v| v.rank == Some(1)).expect("a ranked variant");
-//! assert_eq!(best.status, VariantStatus::Feasible);
+//! assert_eq!(best.status, Status::Feasible);
 //! assert!(best.verification_residual.expect("verified") < 1e-9);
 //! println!("best: {} (ΔQTR {:+.1} %)", best.label(), best.dqtr.unwrap_or_default());
 //! ```

@@ -10,11 +10,11 @@ use counterpoise_model::Model;
 use counterpoise_report as report;
 use report::{
     ActuatorSummary, ElementInfo, Evaluation, FreeDirection, JointPeak, OptimiserInfo,
-    PhysicalParameters, VariantRecord, VariantStatus,
+    PhysicalParameters, VariantRecord,
 };
 
 use crate::error::{Result, StudyError};
-use crate::shard_file::{OptimisedRecord, Outcome};
+use crate::shard_file::OptimisedRecord;
 
 pub(crate) fn capitalised(s: &str) -> String {
     let mut c = s.chars();
@@ -102,12 +102,11 @@ pub(crate) fn record(
             bodies: e.bodies.clone(),
         })
         .collect();
+    // A balanced variant starts as feasible (its verified witness is within the bounds the
+    // search used); the optimiser's verdict, applied below, replaces it.
     let status = match v.status {
-        Status::Balanced => VariantStatus::Feasible,
-        Status::Degenerate => VariantStatus::Degenerate,
-        Status::Unrealizable => VariantStatus::Unrealizable,
-        Status::Infeasible => VariantStatus::Infeasible,
-        Status::Undecided => VariantStatus::Undecided,
+        Status::Balanced => Status::Feasible,
+        verdict => verdict,
     };
     let mut r = VariantRecord::new(id, elements, v.class, status);
     r.reason = v.reason.clone();
@@ -173,28 +172,28 @@ pub(crate) fn record(
             })
             .collect(),
     });
-    match (opt.outcome == Outcome::Feasible, &opt.indicators) {
+    match (opt.outcome == Status::Feasible, &opt.indicators) {
         (true, Some(ind)) => {
-            r.status = VariantStatus::Feasible;
+            r.status = Status::Feasible;
             r.evaluation = Some(evaluation(ind, grid_info));
             if let Some(res) = opt.residual {
                 r.verification_residual = Some(res);
             }
         }
         (true, None) => {
-            r.status = VariantStatus::Discarded;
+            r.status = Status::Discarded;
             r.reason = Some("optimised, but not re-evaluated over all tasks".into());
         }
         (false, _) => {
-            r.status = if opt.outcome == Outcome::Undecided {
-                VariantStatus::Undecided
+            r.status = if opt.outcome == Status::Undecided {
+                Status::Undecided
             } else {
-                VariantStatus::Discarded
+                Status::Discarded
             };
             r.reason = opt.reason.clone();
         }
     }
-    if r.status != VariantStatus::Feasible {
+    if r.status != Status::Feasible {
         // The reports show the balance relations of ranked variants only; the free directions
         // of thousands of unranked variants at Dmax 3 were most of results.json.
         r.relations.clear();

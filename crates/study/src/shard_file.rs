@@ -10,8 +10,9 @@ use std::path::{Path, PathBuf};
 use crate::error::{Result, StudyError, invalid};
 use counterpoise_dynamics::Indicators;
 use counterpoise_model::Model;
-use counterpoise_optimise::{Objective, OptimisedStatus, OptimisedVariant};
+use counterpoise_optimise::{Objective, OptimisedVariant};
 use counterpoise_report::PhaseTiming;
+use counterpoise_vocabulary::Status;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -132,15 +133,6 @@ pub fn case_sha256(model: &Model) -> Result<String> {
         .collect())
 }
 
-/// `feasible`, `discarded` or `undecided`, as the optimiser decided.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Outcome {
-    Feasible,
-    Discarded,
-    Undecided,
-}
-
 /// An optimised counterweight (SI, body frame).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RecordCounterweight {
@@ -170,7 +162,8 @@ pub struct OptimisedRecord {
     /// Index of the variant in the balance search's enumeration.
     pub variant: usize,
     pub elements: Vec<String>,
-    pub outcome: Outcome,
+    /// `feasible`, `discarded` or `undecided`, as the optimiser decided.
+    pub outcome: Status,
     pub reason: Option<String>,
     pub objective: Option<f64>,
     pub lower_bound: Option<f64>,
@@ -193,11 +186,7 @@ impl OptimisedRecord {
         OptimisedRecord {
             variant,
             elements: o.elements.clone(),
-            outcome: match o.status {
-                OptimisedStatus::Feasible => Outcome::Feasible,
-                OptimisedStatus::Discarded => Outcome::Discarded,
-                OptimisedStatus::Undecided => Outcome::Undecided,
-            },
+            outcome: o.status,
             reason: o.reason.clone(),
             objective: o.objective,
             lower_bound: o.lower_bound,

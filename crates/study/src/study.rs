@@ -20,7 +20,7 @@ use counterpoise_dynamics::{EvaluateOptions, Indicators, evaluate_grid};
 use counterpoise_model::{Model, ModelError};
 use counterpoise_optimise::{Context, Objective, OptimiseOptions, optimise_all_reporting};
 use counterpoise_report as report;
-use report::{PhaseTiming, RankingOptions, RunMetadata, RunResults, VariantStatus};
+use report::{PhaseTiming, RankingOptions, RunMetadata, RunResults};
 
 use crate::error::{Result, StudyError, invalid};
 use crate::figures::{
@@ -537,7 +537,7 @@ impl<'m> Study<'m> {
         let fallback = if results
             .variants
             .iter()
-            .any(|v| v.status == VariantStatus::Feasible)
+            .any(|v| v.status == Status::Feasible)
         {
             None
         } else {

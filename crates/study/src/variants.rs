@@ -90,7 +90,7 @@ pub fn to_json(
         )
         .collect();
     let mut counts = serde_json::Map::new();
-    for status in Status::ALL {
+    for status in Status::SEARCH_VERDICTS {
         counts.insert(status.name().into(), json!(report.count(status)));
     }
     json!({
@@ -220,7 +220,7 @@ pub fn tables(model: &Model, dmax: usize, report: &SearchReport, seconds: f64) -
         out.push_str(&format!("{:>16}", c.name()));
     }
     out.push_str(&format!("{:>10}\n", "total"));
-    for status in Status::ALL {
+    for status in Status::SEARCH_VERDICTS {
         out.push_str(&format!("{:<14}", status.name()));
         for c in classes {
             out.push_str(&format!("{:>16}", report.count_class(status, c)));
@@ -421,7 +421,7 @@ pub fn minimal_json(
         )
         .collect();
     let mut counts = serde_json::Map::new();
-    for status in Status::ALL {
+    for status in Status::SEARCH_VERDICTS {
         let n = report.sets.iter().filter(|v| v.status == status).count();
         counts.insert(status.name().into(), json!(n));
     }
@@ -508,7 +508,7 @@ pub fn minimal_tables(model: &Model, dmax: usize, report: &MinimalReport, second
     }
     out.push('\n');
     out.push_str(&format!("{:<6}", "size"));
-    for status in Status::ALL {
+    for status in Status::SEARCH_VERDICTS {
         out.push_str(&format!("{:>14}", status.name()));
     }
     out.push_str(&format!("{:>10}\n", "total"));
@@ -528,7 +528,7 @@ pub fn minimal_tables(model: &Model, dmax: usize, report: &MinimalReport, second
             continue;
         }
         out.push_str(&format!("{d:<6}"));
-        for status in Status::ALL {
+        for status in Status::SEARCH_VERDICTS {
             let n = of_size.iter().filter(|v| v.status == status).count();
             out.push_str(&format!("{n:>14}"));
         }

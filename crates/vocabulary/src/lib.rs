@@ -10,8 +10,10 @@
 
 pub mod element;
 pub mod indicators;
+pub mod status;
 
 pub use element::{Class, ElementKind, Plane};
 pub use indicators::{
     DeltaR, IndicatorError, JointReaction, JointVariation, delta_r, percent_variation,
 };
+pub use status::Status;

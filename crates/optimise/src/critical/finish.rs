@@ -17,7 +17,7 @@ use crate::context::Context;
 use crate::problem::VariantProblem;
 use crate::progress::{ProgressSink, ShareCounter, StageCounter};
 use crate::result::{
-    FreeParameter, OptimisedCounterweight, OptimisedSpring, OptimisedStatus, OptimisedVariant,
+    FreeParameter, OptimisedCounterweight, OptimisedSpring, OptimisedVariant, Status,
 };
 use crate::springs::{SpringValues, realize_springs_reusing};
 use crate::timing::{StageTime, Stopwatch};
@@ -337,7 +337,7 @@ pub(super) fn record(
     let mut out = OptimisedVariant {
         elements: run.elements.clone(),
         class: run.class,
-        status: OptimisedStatus::Discarded,
+        status: Status::Discarded,
         reason: None,
         objective_kind: options.objective,
         objective: None,
@@ -360,14 +360,14 @@ pub(super) fn record(
             return out;
         }
         State::Undecided(reason) => {
-            out.status = OptimisedStatus::Undecided;
+            out.status = Status::Undecided;
             out.reason = Some(reason.clone());
             return out;
         }
         _ => {}
     }
     let (Some(problem), Some(cand)) = (run.problem.as_ref(), run.candidate.as_ref()) else {
-        out.status = OptimisedStatus::Undecided;
+        out.status = Status::Undecided;
         out.reason = Some("no candidate parameters were produced".into());
         return out;
     };
@@ -405,12 +405,12 @@ pub(super) fn record(
     let ind = match indicators {
         Some(Ok(i)) => i,
         Some(Err(e)) => {
-            out.status = OptimisedStatus::Undecided;
+            out.status = Status::Undecided;
             out.reason = Some(format!("final dynamics evaluation failed: {e}"));
             return out;
         }
         None => {
-            out.status = OptimisedStatus::Undecided;
+            out.status = Status::Undecided;
             out.reason = Some("no final evaluation".into());
             return out;
         }
@@ -443,7 +443,7 @@ pub(super) fn record(
             }
         }
         if !report.balance_passed || !report.bounds_passed {
-            out.status = OptimisedStatus::Undecided;
+            out.status = Status::Undecided;
             if !report.balance_passed {
                 why.push(format!(
                     "the optimised parameters balance only to a relative residual of {:.2e} \
@@ -460,7 +460,7 @@ pub(super) fn record(
         }
         out.reason = Some(why.join("; "));
     } else {
-        out.status = OptimisedStatus::Feasible;
+        out.status = Status::Feasible;
     }
     out.verification = Some(report);
     out.indicators = Some(ind);

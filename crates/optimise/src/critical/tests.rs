@@ -6,7 +6,7 @@
 
 use super::peaks::{batched_reaction_peaks, reaction_peaks};
 use super::*;
-use crate::result::{FreeParameter, OptimisedStatus};
+use crate::result::{FreeParameter, Status};
 use crate::springs::realize_springs;
 use crate::torque::TaskTorques;
 use counterpoise_balance::{Catalogue, SearchOptions, catalogue_options, mechanism_energy};
@@ -222,7 +222,7 @@ fn the_final_checks_decide_the_verdict() {
         |run: Run, ind: &Indicators| record(&ctx, run, None, Some(Ok(ind.clone())), &options);
 
     let feasible = verdict(run.clone(), &ind);
-    assert_eq!(feasible.status, OptimisedStatus::Feasible);
+    assert_eq!(feasible.status, Status::Feasible);
     assert_eq!(feasible.reason, None);
     assert!(feasible.residual.unwrap() <= 1e-9);
 
@@ -231,7 +231,7 @@ fn the_final_checks_decide_the_verdict() {
     let mut limited = run.clone();
     limited.problem.as_mut().unwrap().peak_limits = vec![Some(peak1), Some(0.9 * peak2)];
     let over = verdict(limited, &ind);
-    assert_eq!(over.status, OptimisedStatus::Discarded);
+    assert_eq!(over.status, Status::Discarded);
     let task = ind.actuators[1].cpt;
     assert_eq!(
         over.reason.as_deref(),
@@ -252,7 +252,7 @@ fn the_final_checks_decide_the_verdict() {
     cand.cws[0].mu = cand.cws[0].mu.map(|v| v * 1.01);
     let ind_unbalanced = final_indicators(&unbalanced);
     let short = verdict(unbalanced, &ind_unbalanced);
-    assert_eq!(short.status, OptimisedStatus::Undecided);
+    assert_eq!(short.status, Status::Undecided);
     let reason = short.reason.unwrap();
     assert!(
         reason.starts_with("the optimised parameters balance only to a relative residual of"),
@@ -267,7 +267,7 @@ fn the_final_checks_decide_the_verdict() {
     cand.cws[0].mass = 30.0;
     let ind_heavy = final_indicators(&heavy);
     let over_bound = verdict(heavy, &ind_heavy);
-    assert_eq!(over_bound.status, OptimisedStatus::Undecided);
+    assert_eq!(over_bound.status, Status::Undecided);
     let reason = over_bound.reason.unwrap();
     assert!(
         reason.starts_with("the optimised parameters exceed a bound by"),
@@ -278,7 +278,7 @@ fn the_final_checks_decide_the_verdict() {
     let mut undecided = run.clone();
     undecided.state = State::Undecided("the kinematics failed".into());
     let kept = verdict(undecided, &ind);
-    assert_eq!(kept.status, OptimisedStatus::Undecided);
+    assert_eq!(kept.status, Status::Undecided);
     assert_eq!(kept.reason.as_deref(), Some("the kinematics failed"));
 }
 
