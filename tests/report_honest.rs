@@ -12,9 +12,8 @@ use std::path::Path;
 
 use common::run_reduced_palletizer;
 use counterpoise_report::{
-    Class, CounterweightParams, ElementInfo, ElementKind, Evaluation, JointPeak,
-    PhysicalParameters, RankingOptions, RunMetadata, RunResults, SpringParams, Status,
-    VariantRecord, read_results,
+    Class, Counterweight, ElementInfo, ElementKind, Evaluation, JointPeak, PhysicalParameters,
+    RankingOptions, RunMetadata, RunResults, Spring, Status, VariantRecord, read_results,
 };
 
 /// Idle element labels of a variant by the rule, from the raw fields.
@@ -94,7 +93,7 @@ fn sample() -> RunResults {
         eval(100.0, 100.0),
     );
     r.moving_mass = Some(1000.0);
-    let spring = |label: &str| SpringParams {
+    let spring = |label: &str| Spring {
         label: label.into(),
         body: "a".into(),
         other: "base".into(),
@@ -103,7 +102,7 @@ fn sample() -> RunResults {
         anchor_b: [0.0, 0.5, 0.0],
         plane: Some(counterpoise_report::Plane::Xy),
     };
-    let cw = |label: &str, mass: f64| CounterweightParams {
+    let cw = |label: &str, mass: f64| Counterweight {
         label: label.into(),
         body: "a".into(),
         mass,

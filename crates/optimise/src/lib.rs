@@ -51,8 +51,8 @@ pub use overrides::{BoundsTable, CounterweightBounds, ElementBounds, SpringBound
 pub use problem::Objective;
 pub use progress::{ProgressSink, StageProgress, Unit};
 pub use result::{
-    DisplayRow, FreeParameter, Iteration, OptimisedCounterweight, OptimisedSpring,
-    OptimisedVariant, Status, display_rows,
+    Counterweight, DisplayRow, FreeParameter, Iteration, OptimisedVariant, Spring, Status,
+    display_rows,
 };
 pub use timing::{StageTime, Stopwatch, process_cpu_seconds};
 pub use verify::{PeakCheck, VerificationReport};

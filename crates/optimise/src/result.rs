@@ -1,7 +1,7 @@
 //! Serialisable results of the optimisation stage (SI units in the data; [`display_rows`]
 //! gives the paper's Table 1 units: N/mm, mm, kg, rad).
 
-use counterpoise_balance::{Attachment, Class};
+use counterpoise_balance::Class;
 use counterpoise_dynamics::Indicators;
 use serde::Serialize;
 
@@ -13,34 +13,8 @@ use crate::verify::VerificationReport;
 /// `Undecided`.
 pub use counterpoise_vocabulary::Status;
 
-/// An optimised counterweight (SI).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct OptimisedCounterweight {
-    pub label: String,
-    pub body: String,
-    /// kg.
-    pub mass: f64,
-    /// CoM in the body frame, m.
-    pub offset: [f64; 3],
-    /// |r|, m.
-    pub radius: f64,
-}
-
-/// An optimised spring (SI).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct OptimisedSpring {
-    pub label: String,
-    pub body: String,
-    pub other: String,
-    #[serde(skip)]
-    pub other_attachment: Option<Attachment>,
-    /// N/m.
-    pub stiffness: f64,
-    /// m, frame of `body`.
-    pub anchor_a: [f64; 3],
-    /// m, frame of `other`.
-    pub anchor_b: [f64; 3],
-}
+/// The optimised elements are the shared physical-parameter types (SI, body frames).
+pub use counterpoise_vocabulary::{Counterweight, Spring};
 
 /// One free coordinate of the balanced family at the chosen point: the lifted parameters are
 /// `x_p + Σ_k value_k · direction_k` (directions normalised like the balance crate's, largest
@@ -109,8 +83,8 @@ pub struct OptimisedVariant {
     pub iterations: Vec<Iteration>,
     /// The final working set of critical tasks.
     pub critical_tasks: Vec<[usize; 2]>,
-    pub counterweights: Vec<OptimisedCounterweight>,
-    pub springs: Vec<OptimisedSpring>,
+    pub counterweights: Vec<Counterweight>,
+    pub springs: Vec<Spring>,
     pub free_parameters: Vec<FreeParameter>,
     /// ΔR (%) on the reaction tasks used to choose the springs (UB joint-critical tasks and the
     /// critical tasks).
@@ -178,7 +152,7 @@ pub fn display_rows(v: &OptimisedVariant) -> Vec<DisplayRow> {
                 b_mm: None,
                 beta_rad: None,
                 mass_kg: Some(c.mass),
-                r_mm: Some(c.radius * 1e3),
+                r_mm: Some(c.radius() * 1e3),
                 phi_rad: Some(angle(c.offset)),
             });
         } else if let Some(s) = v.springs.iter().find(|s| &s.label == label) {

@@ -26,9 +26,9 @@ fn a_fixed_distance_is_met_exactly() {
     assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let c = &v.counterweights[0];
     assert!(
-        (c.radius - 0.125).abs() <= 1e-9 * 0.125,
+        (c.radius() - 0.125).abs() <= 1e-9 * 0.125,
         "radius {}",
-        c.radius
+        c.radius()
     );
     assert!((c.mass - 8.0).abs() <= 1e-8, "mass {}", c.mass);
 }
@@ -41,7 +41,7 @@ fn a_fixed_mass_is_met_exactly() {
     let v = &results[0];
     assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     assert!((v.counterweights[0].mass - 5.0).abs() <= 1e-9 * 5.0);
-    assert!((v.counterweights[0].radius - 0.2).abs() <= 1e-9);
+    assert!((v.counterweights[0].radius() - 0.2).abs() <= 1e-9);
 }
 
 #[test]

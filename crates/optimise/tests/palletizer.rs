@@ -126,7 +126,11 @@ fn the_papers_eleven_sets() {
                 }
                 for c in &v.counterweights {
                     within(c.mass, &bounds["mass"], &format!("{} mass", c.label));
-                    within(c.radius, &bounds["radius"], &format!("{} radius", c.label));
+                    within(
+                        c.radius(),
+                        &bounds["radius"],
+                        &format!("{} radius", c.label),
+                    );
                 }
                 for k in &v.springs {
                     within(k.stiffness, &bounds["stiffness"], &format!("{} K", k.label));

@@ -119,11 +119,11 @@ fn active_radius_bound() {
     assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
     let (_, f_star) = scan(20.0, 100.0, DENSITY);
     let c = &v.counterweights[0];
-    assert!(c.radius <= 0.05 * (1.0 + 1e-9), "radius {}", c.radius);
+    assert!(c.radius() <= 0.05 * (1.0 + 1e-9), "radius {}", c.radius());
     assert!(
-        (c.radius - 0.05).abs() <= 1e-6 * 0.05,
+        (c.radius() - 0.05).abs() <= 1e-6 * 0.05,
         "radius {} should be on the bound",
-        c.radius
+        c.radius()
     );
     assert!((v.objective.unwrap() - f_star).abs() <= 1e-4 * f_star);
 }

@@ -105,7 +105,11 @@ fn feasible_variants_are_balanced_within_bounds_and_discards_are_proved() {
                     );
                 }
                 for c in &v.counterweights {
-                    assert!((c.radius - 0.2).abs() <= 1e-9, "{name}: |r| = {}", c.radius);
+                    assert!(
+                        (c.radius() - 0.2).abs() <= 1e-9,
+                        "{name}: |r| = {}",
+                        c.radius()
+                    );
                     assert!(
                         c.mass > 0.0 && c.mass <= 5.0 * (1.0 + 1e-9),
                         "{name}: m = {}",

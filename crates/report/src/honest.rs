@@ -169,18 +169,18 @@ impl VariantRecord {
 mod tests {
     use super::*;
     use crate::practical::SpringPeak;
-    use crate::results::{CounterweightParams, SpringParams};
+    use crate::results::{Counterweight, Spring};
 
     fn params(mass: f64) -> PhysicalParameters {
         PhysicalParameters {
-            counterweights: vec![CounterweightParams {
+            counterweights: vec![Counterweight {
                 label: "m6".into(),
                 body: "b".into(),
                 mass,
                 offset: [0.1, 0.0, 0.0],
                 plane: None,
             }],
-            springs: vec![SpringParams {
+            springs: vec![Spring {
                 label: "K42".into(),
                 body: "a".into(),
                 other: "base".into(),

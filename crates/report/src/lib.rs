@@ -90,10 +90,9 @@ pub use partial::{PartialBalancing, PartialDesign, PartialElement};
 pub use practical::{PracticalFigures, SpringPeak};
 pub use ranking::{Class, RankItem, Ranking, RankingError, RankingOptions, rank};
 pub use results::{
-    ActuatorSummary, CounterweightParams, CriticalTask, Curve, ElementInfo, ElementKind,
-    EnergyChart, Evaluation, FreeDirection, JointPeak, OptimiserInfo, PathMechanism, PathRun,
-    PathSimulation, PathStat, PhaseTiming, PhysicalParameters, Plane, RankingInfo, ResultsError,
-    RunMetadata, RunResults, SCHEMA_VERSION, SpringParams, Status, StatusCount, TaskRef,
-    TorqueChart, VariantRecord,
+    ActuatorSummary, Counterweight, CriticalTask, Curve, ElementInfo, ElementKind, EnergyChart,
+    Evaluation, FreeDirection, JointPeak, OptimiserInfo, PathMechanism, PathRun, PathSimulation,
+    PathStat, PhaseTiming, PhysicalParameters, Plane, RankingInfo, ResultsError, RunMetadata,
+    RunResults, SCHEMA_VERSION, Spring, Status, StatusCount, TaskRef, TorqueChart, VariantRecord,
 };
 pub use schematic::{DrawnBody, DrawnCounterweight, DrawnJoint, DrawnSpring, Schematic};

@@ -21,44 +21,8 @@ pub struct ElementInfo {
     pub bodies: Vec<String>,
 }
 
-/// Physical parameters of a counterweight.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CounterweightParams {
-    pub label: String,
-    pub body: String,
-    /// kg.
-    pub mass: f64,
-    /// Centre of mass in the body frame, m.
-    pub offset: [f64; 3],
-    /// Plane of the offset, when the case restricts it to one.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub plane: Option<Plane>,
-}
-
-/// Physical parameters of a zero-free-length spring.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SpringParams {
-    pub label: String,
-    /// Body carrying anchor `a`.
-    pub body: String,
-    /// Body carrying anchor `b` (`base` for the ground).
-    pub other: String,
-    /// N/m.
-    pub stiffness: f64,
-    /// Anchor on `body`, in its frame, m.
-    pub anchor_a: [f64; 3],
-    /// Anchor on `other`, in its frame, m.
-    pub anchor_b: [f64; 3],
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub plane: Option<Plane>,
-}
-
-/// The physical parameters of a variant.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct PhysicalParameters {
-    pub counterweights: Vec<CounterweightParams>,
-    pub springs: Vec<SpringParams>,
-}
+/// The physical parameters of a variant's elements: the shared vocabulary.
+pub use counterpoise_vocabulary::{Counterweight, PhysicalParameters, Spring};
 
 /// One free direction of the balanced family (lifted variable → component).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -98,19 +98,19 @@ impl PracticalFigures {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::results::{CounterweightParams, SpringParams};
+    use crate::results::{Counterweight, Spring};
 
     #[test]
     fn figures_of_a_hybrid_by_hand() {
         let p = PhysicalParameters {
-            counterweights: vec![CounterweightParams {
+            counterweights: vec![Counterweight {
                 label: "m4".into(),
                 body: "arm".into(),
                 mass: 30.0,
                 offset: [0.3, -0.4, 0.0], // |r| = 0.5 m (3-4-5)
                 plane: None,
             }],
-            springs: vec![SpringParams {
+            springs: vec![Spring {
                 label: "K43".into(),
                 body: "arm".into(),
                 other: "forearm".into(),

@@ -25,8 +25,7 @@ use crate::ranking::{Class, RankItem, RankingError, RankingOptions, rank};
 use crate::schematic::Schematic;
 
 pub use crate::parameters::{
-    CounterweightParams, ElementInfo, ElementKind, FreeDirection, PhysicalParameters, Plane,
-    SpringParams,
+    Counterweight, ElementInfo, ElementKind, FreeDirection, PhysicalParameters, Plane, Spring,
 };
 pub use crate::variant::{
     ActuatorSummary, Evaluation, JointPeak, OptimiserInfo, Status, TaskRef, VariantRecord,

@@ -30,7 +30,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::parameters::SpringParams;
+use crate::parameters::Spring;
 use crate::practical::SpringPeak;
 use crate::variant::VariantRecord;
 
@@ -106,7 +106,7 @@ impl SpringSpec {
 
     /// From a spring's parameters and its measured peak (`None` without a shortest length:
     /// results written before it was recorded).
-    pub fn of(s: &SpringParams, peak: &SpringPeak) -> Option<SpringSpec> {
+    pub fn of(s: &Spring, peak: &SpringPeak) -> Option<SpringSpec> {
         Some(SpringSpec::new(
             &s.label,
             s.stiffness,

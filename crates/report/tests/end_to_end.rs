@@ -69,7 +69,7 @@ fn params(labels: &[&str]) -> PhysicalParameters {
     let mut p = PhysicalParameters::default();
     for l in labels {
         if l.starts_with('K') {
-            p.springs.push(SpringParams {
+            p.springs.push(Spring {
                 label: l.to_string(),
                 body: format!("body{}", &l[1..2]),
                 other: format!("body{}", &l[2..3]),
@@ -79,7 +79,7 @@ fn params(labels: &[&str]) -> PhysicalParameters {
                 plane: Some(Plane::Xy),
             });
         } else {
-            p.counterweights.push(CounterweightParams {
+            p.counterweights.push(Counterweight {
                 label: l.to_string(),
                 body: format!("body{}", &l[1..]),
                 mass: 228.6,

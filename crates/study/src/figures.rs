@@ -198,7 +198,7 @@ fn grid_configurations(model: &Model) -> Result<Vec<Vec<f64>>> {
 fn spring_length(
     model: &Model,
     kinematics: &counterpoise_model::Kinematics,
-    s: &report::SpringParams,
+    s: &report::Spring,
     q: &nalgebra::DVector<f64>,
 ) -> Option<f64> {
     let point = |body: &str, anchor: [f64; 3]| -> Option<nalgebra::Vector3<f64>> {

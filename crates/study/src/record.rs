@@ -146,29 +146,23 @@ pub(crate) fn record(
     let spring_plane = balancing
         .and_then(|b| b.springs.as_ref())
         .and_then(|s| s.plane);
+    // The planes are the case's (a shard file written before planes were recorded in it
+    // still gives the report its polar form).
     r.parameters = Some(PhysicalParameters {
         counterweights: opt
             .counterweights
             .iter()
-            .map(|c| report::CounterweightParams {
-                label: c.label.clone(),
-                body: c.body.clone(),
-                mass: c.mass,
-                offset: c.offset,
+            .map(|c| report::Counterweight {
                 plane: cw_plane,
+                ..c.clone()
             })
             .collect(),
         springs: opt
             .springs
             .iter()
-            .map(|s| report::SpringParams {
-                label: s.label.clone(),
-                body: s.body.clone(),
-                other: s.other.clone(),
-                stiffness: s.stiffness,
-                anchor_a: s.anchor_a,
-                anchor_b: s.anchor_b,
+            .map(|s| report::Spring {
                 plane: spring_plane,
+                ..s.clone()
             })
             .collect(),
     });

@@ -12,7 +12,7 @@ use counterpoise_dynamics::Indicators;
 use counterpoise_model::Model;
 use counterpoise_optimise::{Objective, OptimisedVariant};
 use counterpoise_report::PhaseTiming;
-use counterpoise_vocabulary::Status;
+use counterpoise_vocabulary::{Counterweight, Spring, Status};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -133,26 +133,6 @@ pub fn case_sha256(model: &Model) -> Result<String> {
         .collect())
 }
 
-/// An optimised counterweight (SI, body frame).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RecordCounterweight {
-    pub label: String,
-    pub body: String,
-    pub mass: f64,
-    pub offset: [f64; 3],
-}
-
-/// An optimised spring (SI; anchors in the frames of `body` and `other`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RecordSpring {
-    pub label: String,
-    pub body: String,
-    pub other: String,
-    pub stiffness: f64,
-    pub anchor_a: [f64; 3],
-    pub anchor_b: [f64; 3],
-}
-
 /// What the stages after the optimisation read of one variant's optimisation: the same for a
 /// single run and a merge, so that both assemble results.json from the same data. (The
 /// optimiser's full record also holds its iteration log and free parameters, which
@@ -175,8 +155,8 @@ pub struct OptimisedRecord {
     /// Boxes the certified branch-and-bound solved, over all passes.
     #[serde(default)]
     pub boxes: usize,
-    pub counterweights: Vec<RecordCounterweight>,
-    pub springs: Vec<RecordSpring>,
+    pub counterweights: Vec<Counterweight>,
+    pub springs: Vec<Spring>,
     /// Over all tasks, for the finalists.
     pub indicators: Option<Indicators>,
 }
@@ -194,28 +174,8 @@ impl OptimisedRecord {
             residual: o.residual,
             iterations: o.iterations.len(),
             boxes: o.iterations.iter().map(|i| i.boxes).sum(),
-            counterweights: o
-                .counterweights
-                .iter()
-                .map(|c| RecordCounterweight {
-                    label: c.label.clone(),
-                    body: c.body.clone(),
-                    mass: c.mass,
-                    offset: c.offset,
-                })
-                .collect(),
-            springs: o
-                .springs
-                .iter()
-                .map(|s| RecordSpring {
-                    label: s.label.clone(),
-                    body: s.body.clone(),
-                    other: s.other.clone(),
-                    stiffness: s.stiffness,
-                    anchor_a: s.anchor_a,
-                    anchor_b: s.anchor_b,
-                })
-                .collect(),
+            counterweights: o.counterweights.clone(),
+            springs: o.springs.clone(),
             indicators: o.indicators.clone(),
         }
     }

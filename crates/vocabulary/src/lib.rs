@@ -10,10 +10,12 @@
 
 pub mod element;
 pub mod indicators;
+pub mod parameters;
 pub mod status;
 
 pub use element::{Class, ElementKind, Plane};
 pub use indicators::{
     DeltaR, IndicatorError, JointReaction, JointVariation, delta_r, percent_variation,
 };
+pub use parameters::{Counterweight, PhysicalParameters, Spring};
 pub use status::Status;

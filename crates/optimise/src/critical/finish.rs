@@ -16,9 +16,7 @@ use super::state::*;
 use crate::context::Context;
 use crate::problem::VariantProblem;
 use crate::progress::{ProgressSink, ShareCounter, StageCounter};
-use crate::result::{
-    FreeParameter, OptimisedCounterweight, OptimisedSpring, OptimisedVariant, Status,
-};
+use crate::result::{Counterweight, FreeParameter, OptimisedVariant, Spring, Status};
 use crate::springs::{SpringValues, realize_springs_reusing};
 use crate::timing::{StageTime, Stopwatch};
 use crate::verify::verify;
@@ -372,32 +370,39 @@ pub(super) fn record(
         return out;
     };
     let name = |b: usize| ctx.model.bodies[b].name.clone();
+    let balancing = ctx.model.balancing.as_ref();
+    let cw_plane = balancing
+        .and_then(|b| b.counterweights.as_ref())
+        .and_then(|c| c.plane);
+    let spring_plane = balancing
+        .and_then(|b| b.springs.as_ref())
+        .and_then(|s| s.plane);
     out.counterweights = problem
         .counterweights
         .iter()
         .zip(&cand.cws)
-        .map(|(slot, p)| OptimisedCounterweight {
+        .map(|(slot, p)| Counterweight {
             label: slot.label.clone(),
             body: name(slot.body),
             mass: p.mass,
             offset: p.offset(),
-            radius: p.radius(),
+            plane: cw_plane,
         })
         .collect();
     out.springs = cand
         .springs
         .iter()
-        .map(|s| OptimisedSpring {
+        .map(|s| Spring {
             label: s.label.clone(),
             body: name(s.body),
             other: match s.other {
                 Attachment::Base => "base".into(),
                 Attachment::Body(b) => name(b),
             },
-            other_attachment: Some(s.other),
             stiffness: s.stiffness,
             anchor_a: s.anchor_a,
             anchor_b: s.anchor_b,
+            plane: spring_plane,
         })
         .collect();
     out.free_parameters = free_parameters(problem, &lifted_names(ctx, problem), &cand.x);
