@@ -23,7 +23,7 @@ use std::time::Duration;
 #[path = "../tests/common/variants.rs"]
 mod variants;
 
-use variants::{balanced, dynamics_variant};
+use variants::balanced;
 
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{
@@ -60,7 +60,8 @@ fn synthetic_dmax3(model: &Model, finals: &[Variant], count: usize) -> Vec<Varia
     let cw_bodies: Vec<usize> = {
         let mut b: Vec<usize> = finals
             .iter()
-            .flat_map(|v| v.counterweights.iter().map(|c| c.body))
+            .flat_map(|v| v.counterweights.iter())
+            .map(|c| model.body_index(&c.body).expect("a body of the model"))
             .collect();
         b.sort_unstable();
         b.dedup();
@@ -72,12 +73,16 @@ fn synthetic_dmax3(model: &Model, finals: &[Variant], count: usize) -> Vec<Varia
         .map(|k| {
             let scale = 1.0 + 0.001 * k as f64;
             let cw = |i: usize| Counterweight {
-                body: cw_bodies[(k + i) % cw_bodies.len()],
+                label: format!("m{i}"),
+                body: model.bodies[cw_bodies[(k + i) % cw_bodies.len()]]
+                    .name
+                    .clone(),
                 mass: 50.0 * scale + 10.0 * i as f64,
-                position: [-0.3 * scale, 0.02 * i as f64, 0.0],
+                offset: [-0.3 * scale, 0.02 * i as f64, 0.0],
+                plane: None,
             };
             let spring = |i: usize| {
-                let mut s = springs[(3 * k + 7 * i) % springs.len()];
+                let mut s = springs[(3 * k + 7 * i) % springs.len()].clone();
                 s.stiffness *= scale;
                 s
             };
@@ -129,7 +134,7 @@ fn pipeline(c: &mut Criterion) {
     let finals: Vec<Variant> = study(&model, 2)
         .iter()
         .filter(|o| o.is_feasible())
-        .map(|o| dynamics_variant(&model, o))
+        .map(|o| o.physical_parameters())
         .collect();
     let params = ParameterSet::from_variants(&model, &finals).expect("variants");
     let mut group = c.benchmark_group("final_grid");

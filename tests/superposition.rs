@@ -8,7 +8,7 @@ mod common;
 
 use std::time::Instant;
 
-use common::variants::{balanced, dynamics_variant};
+use common::variants::balanced;
 
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{
@@ -40,7 +40,7 @@ fn every_reaction_peak_of_every_feasible_dmax2_variant_equals_the_direct_solve()
     let variants: Vec<Variant> = optimised
         .iter()
         .filter(|o| o.is_feasible())
-        .map(|o| dynamics_variant(&model, o))
+        .map(|o| o.physical_parameters())
         .collect();
     // README: 50 feasible variants at Dmax 2, of every class
     assert_eq!(variants.len(), 50);
@@ -104,18 +104,21 @@ fn every_reaction_peak_of_every_feasible_dmax2_variant_equals_the_direct_solve()
 fn a_superposed_column_is_the_same_bits_in_any_batch() {
     let case = common::reduced_palletizer(3, 11);
     let model = Case::from_json_str(&serde_json::to_string(&case).unwrap()).unwrap();
-    let b = |name: &str| model.body_index(name).unwrap();
     let cw = |body: &str, mass: f64| Counterweight {
-        body: b(body),
+        label: format!("m on {body}"),
+        body: body.into(),
         mass,
-        position: [-0.3, 0.01, 0.0],
+        offset: [-0.3, 0.01, 0.0],
+        plane: None,
     };
     let spring = |body: &str, other: &str, stiffness: f64| Spring {
-        body: b(body),
-        other: Some(b(other)),
+        label: format!("K {body}–{other}"),
+        body: body.into(),
+        other: other.into(),
         stiffness,
-        anchor: [0.3, 0.0, 0.0],
-        other_anchor: [-0.2, 0.45, 0.0],
+        anchor_a: [0.3, 0.0, 0.0],
+        anchor_b: [-0.2, 0.45, 0.0],
+        plane: None,
     };
     let variants = [
         Variant {

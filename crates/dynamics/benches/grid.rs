@@ -22,9 +22,11 @@ fn thirteen_columns(model: &Model) -> ParameterSet {
     for c in 0..7 {
         variants.push(Variant {
             counterweights: vec![Counterweight {
-                body: c,
+                label: "cw".into(),
+                body: model.bodies[c].name.clone(),
                 mass: 20.0 + 10.0 * c as f64,
-                position: [-0.3, 0.05, 0.0],
+                offset: [-0.3, 0.05, 0.0],
+                plane: None,
             }],
             springs: vec![],
         });
@@ -33,11 +35,13 @@ fn thirteen_columns(model: &Model) -> ParameterSet {
         variants.push(Variant {
             counterweights: vec![],
             springs: vec![Spring {
-                body: i,
-                other: Some(s),
+                label: "spring".into(),
+                body: model.bodies[i].name.clone(),
+                other: model.bodies[s].name.clone(),
                 stiffness: 4000.0,
-                anchor: [0.4, 0.0, 0.0],
-                other_anchor: [0.0, 0.3, 0.0],
+                anchor_a: [0.4, 0.0, 0.0],
+                anchor_b: [0.0, 0.3, 0.0],
+                plane: None,
             }],
         });
     }

@@ -18,9 +18,11 @@ fn main() {
     for c in 1..columns {
         variants.push(Variant {
             counterweights: vec![Counterweight {
-                body: c % 7,
+                label: "cw".into(),
+                body: model.bodies[c % 7].name.clone(),
                 mass: 10.0 * c as f64,
-                position: [-0.3, 0.05 * c as f64, 0.0],
+                offset: [-0.3, 0.05 * c as f64, 0.0],
+                plane: None,
             }],
             springs: vec![],
         });

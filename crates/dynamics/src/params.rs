@@ -11,7 +11,7 @@
 //! `a` in its frame) and body `s` or the base (anchor `b`): `(K, α = K·a, β = K·b, W = K·a·bᵀ)`,
 //! `W` row-major. Springs are massless and contribute their static forces only.
 
-use counterpoise_model::{CounterweightShape, Model, Plane};
+use counterpoise_model::{BodyId, CounterweightShape, Model, Plane};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -30,35 +30,14 @@ pub struct SpringSlot {
     pub other: Option<usize>,
 }
 
-/// A cylindrical (or point) counterweight of mass `mass` centred at `position` in the frame
-/// of `body`.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Counterweight {
-    pub body: usize,
-    pub mass: f64,
-    pub position: [f64; 3],
-}
+/// A counterweight and a zero-free-length spring are the shared physical-parameter types; they
+/// name their bodies, resolved to the model's indices once per column
+/// ([`ParameterSet::from_variants`]).
+pub use counterpoise_vocabulary::{Counterweight, Spring};
 
-/// A zero-free-length spring (see [`SpringSlot`]).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Spring {
-    pub body: usize,
-    pub other: Option<usize>,
-    pub stiffness: f64,
-    /// Anchor on `body`, in its frame.
-    pub anchor: [f64; 3],
-    /// Anchor on `other` (or in the world frame for the base).
-    pub other_anchor: [f64; 3],
-}
-
-/// A set of balancing elements added to the model (the empty variant is the unbalanced robot).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Variant {
-    #[serde(default)]
-    pub counterweights: Vec<Counterweight>,
-    #[serde(default)]
-    pub springs: Vec<Spring>,
-}
+/// A set of balancing elements added to the model (the empty variant is the unbalanced robot):
+/// the shared physical parameters of a variant.
+pub use counterpoise_vocabulary::PhysicalParameters as Variant;
 
 /// Many parameter columns over the same bodies and spring slots.
 #[derive(Clone, Debug, PartialEq)]
@@ -221,16 +200,7 @@ impl ParameterSet {
         let mut slots: Vec<SpringSlot> = Vec::new();
         for v in variants {
             for s in &v.springs {
-                if s.body >= l || s.other.is_some_and(|o| o >= l) {
-                    return Err(DynamicsError::BadParameters(format!(
-                        "spring on body {} / {:?}: no such body",
-                        s.body, s.other
-                    )));
-                }
-                let slot = SpringSlot {
-                    body: s.body,
-                    other: s.other,
-                };
+                let slot = spring_slot(model, s)?;
                 if !slots.contains(&slot) {
                     slots.push(slot);
                 }
@@ -245,25 +215,26 @@ impl ParameterSet {
             let mut col = base.clone();
             col.resize(set.rows(), 0.0);
             for c in &v.counterweights {
-                if c.body >= l {
-                    return Err(DynamicsError::BadParameters(format!(
-                        "counterweight on body {}: no such body",
-                        c.body
-                    )));
-                }
+                let body = model.body_index(&c.body).ok_or_else(|| {
+                    DynamicsError::BadParameters(format!(
+                        "counterweight {} on body {:?}: no such body",
+                        c.label, c.body
+                    ))
+                })?;
                 let inertia = counterweight_inertia(model, c.mass);
-                let add = body_params(c.mass, &Vector3::from(c.position), &inertia);
-                for (x, y) in col[BODY_PARAMS * c.body..].iter_mut().zip(add) {
+                let add = body_params(c.mass, &Vector3::from(c.offset), &inertia);
+                for (x, y) in col[BODY_PARAMS * body..].iter_mut().zip(add) {
                     *x += y;
                 }
             }
             for s in &v.springs {
+                let wanted = spring_slot(model, s)?;
                 let slot = set
                     .springs
                     .iter()
-                    .position(|x| x.body == s.body && x.other == s.other)
+                    .position(|x| *x == wanted)
                     .expect("slot registered above");
-                let add = spring_params(s.stiffness, &s.anchor, &s.other_anchor);
+                let add = spring_params(s.stiffness, &s.anchor_a, &s.anchor_b);
                 let off = BODY_PARAMS * l + SPRING_PARAMS * slot;
                 for (x, y) in col[off..].iter_mut().zip(add) {
                     *x += y;
@@ -273,6 +244,19 @@ impl ParameterSet {
         }
         Ok(set)
     }
+}
+
+/// The slot of a spring: its bodies' indices (`base` is the ground).
+fn spring_slot(model: &Model, s: &Spring) -> Result<SpringSlot, DynamicsError> {
+    let unknown = |name: &str| {
+        DynamicsError::BadParameters(format!("spring {} on body {name:?}: no such body", s.label))
+    };
+    let body = model.body_index(&s.body).ok_or_else(|| unknown(&s.body))?;
+    let other = match model.body_id(&s.other).ok_or_else(|| unknown(&s.other))? {
+        BodyId::Base => None,
+        BodyId::Body(b) => Some(b),
+    };
+    Ok(SpringSlot { body, other })
 }
 
 #[cfg(test)]

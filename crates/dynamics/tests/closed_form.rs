@@ -101,9 +101,11 @@ fn counterweight_balancing_the_pendulum_leaves_no_static_torque() {
     // m·r = −m_rod·c: 4 kg at x = −0.25 m.
     let variant = Variant {
         counterweights: vec![Counterweight {
-            body: 0,
+            label: "cw".into(),
+            body: model.bodies[0].name.clone(),
             mass: 4.0,
-            position: [-0.25, 0.0, 0.0],
+            offset: [-0.25, 0.0, 0.0],
+            plane: None,
         }],
         springs: vec![],
     };
@@ -131,11 +133,13 @@ fn base_spring_balancing_the_pendulum() {
     let variant = Variant {
         counterweights: vec![],
         springs: vec![Spring {
-            body: 0,
-            other: None,
+            label: "spring".into(),
+            body: model.bodies[0].name.clone(),
+            other: "base".into(),
             stiffness: k,
-            anchor: [a, 0.0, 0.0],
-            other_anchor: [0.0, b, 0.0],
+            anchor_a: [a, 0.0, 0.0],
+            anchor_b: [0.0, b, 0.0],
+            plane: None,
         }],
     };
     let params = ParameterSet::from_variants(&model, &[Variant::default(), variant]).unwrap();
@@ -243,9 +247,11 @@ fn cylinder_counterweight_with_tau_not_one() {
     let model = common::case_from_text(&json.to_string());
     let variant = Variant {
         counterweights: vec![Counterweight {
-            body: 0,
+            label: "cw".into(),
+            body: model.bodies[0].name.clone(),
             mass: m,
-            position: [r, 0.0, 0.0],
+            offset: [r, 0.0, 0.0],
+            plane: None,
         }],
         springs: vec![],
     };

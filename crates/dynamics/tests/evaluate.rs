@@ -150,16 +150,20 @@ fn same_results_with_one_and_two_threads() {
         Variant::default(),
         Variant {
             counterweights: vec![Counterweight {
-                body: 3,
+                label: "cw".into(),
+                body: model.bodies[3].name.clone(),
                 mass: 80.0,
-                position: [-0.4, 0.1, 0.0],
+                offset: [-0.4, 0.1, 0.0],
+                plane: None,
             }],
             springs: vec![Spring {
-                body: 3,
-                other: Some(2),
+                label: "spring".into(),
+                body: model.bodies[3].name.clone(),
+                other: model.bodies[2].name.clone(),
                 stiffness: 5000.0,
-                anchor: [0.5, 0.0, 0.0],
-                other_anchor: [0.0, 0.2, 0.0],
+                anchor_a: [0.5, 0.0, 0.0],
+                anchor_b: [0.0, 0.2, 0.0],
+                plane: None,
             }],
         },
     ];
@@ -234,33 +238,41 @@ fn cyclic_shortcut_matches_direct_evaluation() {
         Variant::default(),
         Variant {
             counterweights: vec![Counterweight {
-                body: 4,
+                label: "cw".into(),
+                body: model.bodies[4].name.clone(),
                 mass: 60.0,
-                position: [-0.3, 0.05, 0.0],
+                offset: [-0.3, 0.05, 0.0],
+                plane: None,
             }],
             springs: vec![Spring {
-                body: 5,
-                other: Some(1),
+                label: "spring".into(),
+                body: model.bodies[5].name.clone(),
+                other: model.bodies[1].name.clone(),
                 stiffness: 3000.0,
-                anchor: [0.2, 0.1, 0.0],
-                other_anchor: [0.1, -0.3, 0.0],
+                anchor_a: [0.2, 0.1, 0.0],
+                anchor_b: [0.1, -0.3, 0.0],
+                plane: None,
             }],
         },
         // More than two columns (the shared-regressor path) and more reaction right-hand
         // sides per sample than one lane chunk of the solver, the last chunk partial.
         Variant {
             counterweights: vec![Counterweight {
-                body: 2,
+                label: "cw".into(),
+                body: model.bodies[2].name.clone(),
                 mass: 25.0,
-                position: [0.1, -0.2, 0.05],
+                offset: [0.1, -0.2, 0.05],
+                plane: None,
             }],
             springs: vec![],
         },
         Variant {
             counterweights: vec![Counterweight {
-                body: 6,
+                label: "cw".into(),
+                body: model.bodies[6].name.clone(),
                 mass: 40.0,
-                position: [-0.2, 0.0, 0.1],
+                offset: [-0.2, 0.0, 0.1],
+                plane: None,
             }],
             springs: vec![],
         },
@@ -269,21 +281,25 @@ fn cyclic_shortcut_matches_direct_evaluation() {
         Variant {
             counterweights: vec![],
             springs: vec![Spring {
-                body: 5,
-                other: Some(1),
+                label: "spring".into(),
+                body: model.bodies[5].name.clone(),
+                other: model.bodies[1].name.clone(),
                 stiffness: 5000.0,
-                anchor: [-0.1, 0.2, 0.0],
-                other_anchor: [0.0, 0.3, 0.05],
+                anchor_a: [-0.1, 0.2, 0.0],
+                anchor_b: [0.0, 0.3, 0.05],
+                plane: None,
             }],
         },
         Variant {
             counterweights: vec![],
             springs: vec![Spring {
-                body: 6,
-                other: Some(2),
+                label: "spring".into(),
+                body: model.bodies[6].name.clone(),
+                other: model.bodies[2].name.clone(),
                 stiffness: 1500.0,
-                anchor: [0.3, 0.0, 0.1],
-                other_anchor: [-0.2, 0.1, 0.0],
+                anchor_a: [0.3, 0.0, 0.1],
+                anchor_b: [-0.2, 0.1, 0.0],
+                plane: None,
             }],
         },
     ];
@@ -359,11 +375,13 @@ fn grid_reaction_peaks_match_the_per_task_series() {
     let variant = Variant {
         counterweights: vec![],
         springs: vec![Spring {
-            body: 3,
-            other: None,
+            label: "spring".into(),
+            body: model.bodies[3].name.clone(),
+            other: "base".into(),
             stiffness: 5000.0,
-            anchor: [0.5, 0.0, 0.0],
-            other_anchor: [0.0, 0.0, 0.5],
+            anchor_a: [0.5, 0.0, 0.0],
+            anchor_b: [0.0, 0.0, 0.5],
+            plane: None,
         }],
     };
     let params = ParameterSet::from_variants(&model, &[variant]).unwrap();

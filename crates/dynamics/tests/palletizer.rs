@@ -361,9 +361,11 @@ fn balanced_witness_has_no_static_torque() {
     let arm = model.body_index("upper_arm").unwrap();
     let variant = Variant {
         counterweights: vec![Counterweight {
-            body: arm,
+            label: "cw".into(),
+            body: model.bodies[arm].name.clone(),
             mass: m,
-            position: [rx, 0.0, 0.0],
+            offset: [rx, 0.0, 0.0],
+            plane: None,
         }],
         springs: vec![],
     };

@@ -9,31 +9,37 @@ use counterpoise_dynamics::{
     evaluate_grid_indicators,
 };
 
-fn variants() -> Vec<Variant> {
+fn variants(model: &counterpoise_model::Model) -> Vec<Variant> {
     vec![
         Variant::default(),
         Variant {
             counterweights: vec![Counterweight {
-                body: 4,
+                label: "cw".into(),
+                body: model.bodies[4].name.clone(),
                 mass: 60.0,
-                position: [-0.3, 0.05, 0.0],
+                offset: [-0.3, 0.05, 0.0],
+                plane: None,
             }],
             springs: vec![Spring {
-                body: 5,
-                other: Some(1),
+                label: "spring".into(),
+                body: model.bodies[5].name.clone(),
+                other: model.bodies[1].name.clone(),
                 stiffness: 3000.0,
-                anchor: [0.2, 0.1, 0.0],
-                other_anchor: [0.1, -0.3, 0.0],
+                anchor_a: [0.2, 0.1, 0.0],
+                anchor_b: [0.1, -0.3, 0.0],
+                plane: None,
             }],
         },
         Variant {
             counterweights: vec![],
             springs: vec![Spring {
-                body: 6,
-                other: Some(2),
+                label: "spring".into(),
+                body: model.bodies[6].name.clone(),
+                other: model.bodies[2].name.clone(),
                 stiffness: 1500.0,
-                anchor: [0.3, 0.0, 0.1],
-                other_anchor: [-0.2, 0.1, 0.0],
+                anchor_a: [0.3, 0.0, 0.1],
+                anchor_b: [-0.2, 0.1, 0.0],
+                plane: None,
             }],
         },
         // Same inertia as the first column: every value of a column with the same inertia
@@ -45,7 +51,7 @@ fn variants() -> Vec<Variant> {
 #[test]
 fn streaming_indicators_equal_the_table_reduction() {
     let model = coarse_palletizer();
-    let params = ParameterSet::from_variants(&model, &variants()).unwrap();
+    let params = ParameterSet::from_variants(&model, &variants(&model)).unwrap();
     for reactions in [false, true] {
         let options = EvaluateOptions {
             reactions,

@@ -14,7 +14,7 @@ use crate::verify::VerificationReport;
 pub use counterpoise_vocabulary::Status;
 
 /// The optimised elements are the shared physical-parameter types (SI, body frames).
-pub use counterpoise_vocabulary::{Counterweight, Spring};
+pub use counterpoise_vocabulary::{Counterweight, PhysicalParameters, Spring};
 
 /// One free coordinate of the balanced family at the chosen point: the lifted parameters are
 /// `x_p + Σ_k value_k · direction_k` (directions normalised like the balance crate's, largest
@@ -98,6 +98,14 @@ pub struct OptimisedVariant {
 }
 
 impl OptimisedVariant {
+    /// The optimised elements: what the dynamics crate evaluates and the results record.
+    pub fn physical_parameters(&self) -> PhysicalParameters {
+        PhysicalParameters {
+            counterweights: self.counterweights.clone(),
+            springs: self.springs.clone(),
+        }
+    }
+
     pub fn is_feasible(&self) -> bool {
         self.status == Status::Feasible
     }

@@ -23,6 +23,9 @@ const TOOL: f64 = 1.0;
 const L1: f64 = 0.8;
 const L2: f64 = 0.6;
 const M1_FIXED: f64 = 12.0;
+/// The bodies of cases/two_link.json.
+const LINK1: &str = "link1";
+const LINK2: &str = "link2";
 
 fn case(m2_range: [f64; 2], peak: Option<f64>) -> serde_json::Value {
     let mut json = common::case_json("two_link.json");
@@ -44,14 +47,18 @@ fn variant(m2: f64) -> Variant {
     Variant {
         counterweights: vec![
             Counterweight {
-                body: 0,
+                label: "m1".into(),
+                body: LINK1.into(),
                 mass: M1_FIXED,
-                position: [mu1 / M1_FIXED, 0.0, 0.0],
+                offset: [mu1 / M1_FIXED, 0.0, 0.0],
+                plane: None,
             },
             Counterweight {
-                body: 1,
+                label: "m2".into(),
+                body: LINK2.into(),
                 mass: m2,
-                position: [mu2 / m2, 0.0, 0.0],
+                offset: [mu2 / m2, 0.0, 0.0],
+                plane: None,
             },
         ],
         springs: Vec::new(),

@@ -3,13 +3,12 @@
 //! path simulation, and the practical figures (added mass, spring peaks and stretch).
 
 use counterpoise_dynamics::params::ParameterSet;
-use counterpoise_dynamics::{Counterweight, Spring, Variant, task_series_with};
+use counterpoise_dynamics::{Variant, task_series_with};
 use counterpoise_model::Model;
 use counterpoise_report as report;
 use report::{RunResults, Status};
 
 use crate::error::{Result, StudyError};
-use crate::record::dynamics_variant;
 use crate::shard_file::OptimisedRecord;
 
 /// The unbalanced robot and the variants the report shows (the best-ranked and the
@@ -32,7 +31,7 @@ pub fn shown_mechanisms(
         let Some(opt) = optimised.iter().find(|o| o.label() == label) else {
             continue;
         };
-        variants.push(dynamics_variant(model, opt)?);
+        variants.push(opt.physical_parameters());
         labels.push((results.shown_label(v), Some(v.id)));
     }
     Ok(Mechanisms {
@@ -44,43 +43,18 @@ pub fn shown_mechanisms(
 /// [`shown_mechanisms`] from the parameters stored in the results (`report DIR`, which has no
 /// optimiser records).
 pub fn shown_mechanisms_of_results(model: &Model, results: &RunResults) -> Result<Mechanisms> {
-    let body = |name: &str| {
-        model.body_index(name).ok_or_else(|| {
-            StudyError::Invalid(format!("results.json names an unknown body `{name}`"))
-        })
-    };
     let mut variants = vec![Variant::default()];
     let mut labels = vec![("UB".to_string(), None)];
     for v in results.shown_variants() {
         let Some(p) = &v.parameters else { continue };
-        let mut d = Variant::default();
-        for c in &p.counterweights {
-            d.counterweights.push(Counterweight {
-                body: body(&c.body)?,
-                mass: c.mass,
-                position: c.offset,
-            });
-        }
-        for s in &p.springs {
-            d.springs.push(Spring {
-                body: body(&s.body)?,
-                other: if s.other == "base" {
-                    None
-                } else {
-                    Some(body(&s.other)?)
-                },
-                stiffness: s.stiffness,
-                anchor: s.anchor_a,
-                other_anchor: s.anchor_b,
-            });
-        }
-        variants.push(d);
+        variants.push(p.clone());
         labels.push((results.shown_label(v), Some(v.id)));
     }
-    Ok(Mechanisms {
-        params: ParameterSet::from_variants(model, &variants)?,
-        labels,
-    })
+    // The bodies are named in results.json: one the case does not have is the user's mistake
+    // (results of another case), said as such.
+    let params = ParameterSet::from_variants(model, &variants)
+        .map_err(|e| StudyError::Invalid(format!("results.json does not fit the case: {e}")))?;
+    Ok(Mechanisms { params, labels })
 }
 
 /// Samples per path segment in the path simulation.

@@ -5,7 +5,7 @@
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use counterpoise_balance::{Status, VariantResult};
-use counterpoise_dynamics::{Counterweight, Indicators, Spring, Variant};
+use counterpoise_dynamics::Indicators;
 use counterpoise_model::Model;
 use counterpoise_report as report;
 use report::{
@@ -13,7 +13,6 @@ use report::{
     PhysicalParameters, VariantRecord,
 };
 
-use crate::error::{Result, StudyError};
 use crate::shard_file::OptimisedRecord;
 
 pub(crate) fn capitalised(s: &str) -> String {
@@ -205,35 +204,4 @@ fn significant(x: f64, digits: usize) -> f64 {
     format!("{x:.*e}", digits.saturating_sub(1))
         .parse()
         .unwrap_or(x)
-}
-
-/// The dynamics crate's description of a variant's elements.
-pub(crate) fn dynamics_variant(model: &Model, opt: &OptimisedRecord) -> Result<Variant> {
-    let body = |name: &str| {
-        model
-            .body_index(name)
-            .ok_or_else(|| StudyError::Invalid(format!("optimiser named an unknown body `{name}`")))
-    };
-    let mut v = Variant::default();
-    for c in &opt.counterweights {
-        v.counterweights.push(Counterweight {
-            body: body(&c.body)?,
-            mass: c.mass,
-            position: c.offset,
-        });
-    }
-    for s in &opt.springs {
-        v.springs.push(Spring {
-            body: body(&s.body)?,
-            other: if s.other == "base" {
-                None
-            } else {
-                Some(body(&s.other)?)
-            },
-            stiffness: s.stiffness,
-            anchor: s.anchor_a,
-            other_anchor: s.anchor_b,
-        });
-    }
-    Ok(v)
 }

@@ -12,7 +12,7 @@ use counterpoise_dynamics::Indicators;
 use counterpoise_model::Model;
 use counterpoise_optimise::{Objective, OptimisedVariant};
 use counterpoise_report::PhaseTiming;
-use counterpoise_vocabulary::{Counterweight, Spring, Status};
+use counterpoise_vocabulary::{Counterweight, PhysicalParameters, Spring, Status};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -177,6 +177,14 @@ impl OptimisedRecord {
             counterweights: o.counterweights.clone(),
             springs: o.springs.clone(),
             indicators: o.indicators.clone(),
+        }
+    }
+
+    /// The optimised elements: what the dynamics evaluates and the report records.
+    pub fn physical_parameters(&self) -> PhysicalParameters {
+        PhysicalParameters {
+            counterweights: self.counterweights.clone(),
+            springs: self.springs.clone(),
         }
     }
 

@@ -17,5 +17,5 @@ pub use element::{Class, ElementKind, Plane};
 pub use indicators::{
     DeltaR, IndicatorError, JointReaction, JointVariation, delta_r, percent_variation,
 };
-pub use parameters::{Counterweight, PhysicalParameters, Spring};
+pub use parameters::{BASE, Counterweight, PhysicalParameters, Spring};
 pub use status::Status;

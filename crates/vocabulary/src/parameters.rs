@@ -49,6 +49,16 @@ pub struct PhysicalParameters {
     pub springs: Vec<Spring>,
 }
 
+/// The name of the fixed ground in a spring's `other` (the case format's name for it).
+pub const BASE: &str = "base";
+
+impl Spring {
+    /// Whether anchor `b` is on the fixed ground.
+    pub fn to_base(&self) -> bool {
+        self.other == BASE
+    }
+}
+
 impl Counterweight {
     /// `|offset|`, m: the reach the bounds limit.
     pub fn radius(&self) -> f64 {
@@ -81,5 +91,24 @@ mod tests {
         assert!(json.contains("\"plane\":\"xz\""), "{json}");
         let back: Counterweight = serde_json::from_str(&json).unwrap();
         assert_eq!(back, with_plane);
+    }
+
+    #[test]
+    fn a_spring_to_the_base_names_it() {
+        let s = Spring {
+            label: "K41".into(),
+            body: "upper_arm".into(),
+            other: BASE.into(),
+            stiffness: 1e3,
+            anchor_a: [0.0; 3],
+            anchor_b: [0.0; 3],
+            plane: None,
+        };
+        assert!(s.to_base());
+        let between = Spring {
+            other: "column".into(),
+            ..s
+        };
+        assert!(!between.to_base());
     }
 }

@@ -150,7 +150,7 @@ pub(super) fn finish(
         })
         .collect();
     let share = ShareCounter::start(progress, "final evaluation", 0, finals.len());
-    let variants = candidate_variants(&runs, &finals);
+    let variants = candidate_variants(&ctx.model, &runs, &finals);
     let final_indicators = if variants.is_empty() {
         Ok(Vec::new())
     } else {
@@ -247,7 +247,7 @@ pub(super) fn spring_options(
     }
     let variants: Vec<Variant> = found
         .iter()
-        .map(|(s, _)| dynamics_variant(problem, &cand.cws, s))
+        .map(|(s, _)| dynamics_variant(&ctx.model, problem, &cand.cws, s))
         .collect();
     let tasks: Vec<usize> = joint_tasks
         .iter()

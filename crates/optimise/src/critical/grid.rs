@@ -6,6 +6,7 @@ use counterpoise_dynamics::params::{Counterweight, ParameterSet, Spring, Variant
 use counterpoise_dynamics::{
     Combination, EvaluateOptions, GridProgress, Indicators, evaluate_grid_indicators_reporting,
 };
+use counterpoise_model::Model;
 
 use super::state::*;
 use crate::context::Context;
@@ -15,11 +16,12 @@ use crate::springs::SpringValues;
 
 /// The dynamics variants of the current candidates of runs `ks` (each has a problem and a
 /// candidate).
-pub(super) fn candidate_variants(runs: &[Run], ks: &[usize]) -> Vec<Variant> {
+pub(super) fn candidate_variants(model: &Model, runs: &[Run], ks: &[usize]) -> Vec<Variant> {
     ks.iter()
         .map(|&k| {
             let cand = runs[k].candidate.as_ref().expect("candidate");
             dynamics_variant(
+                model,
                 runs[k].problem.as_ref().expect("problem"),
                 &cand.cws,
                 &cand.springs,
@@ -28,35 +30,49 @@ pub(super) fn candidate_variants(runs: &[Run], ks: &[usize]) -> Vec<Variant> {
         .collect()
 }
 
-/// The dynamics crate's variant of physical counterweights `cws` (in the problem's slot order)
-/// and realized springs.
+/// The physical parameters of counterweights `cws` (in the problem's slot order) and realized
+/// springs, named as the results record them (the case's plane for each kind): the variant the
+/// dynamics crate evaluates and the optimiser reports.
 pub(super) fn dynamics_variant(
+    model: &Model,
     problem: &VariantProblem,
     cws: &[CwPhysical],
     springs: &[SpringValues],
 ) -> Variant {
+    let name = |b: usize| model.bodies[b].name.clone();
+    let balancing = model.balancing.as_ref();
+    let cw_plane = balancing
+        .and_then(|b| b.counterweights.as_ref())
+        .and_then(|c| c.plane);
+    let spring_plane = balancing
+        .and_then(|b| b.springs.as_ref())
+        .and_then(|s| s.plane);
     Variant {
         counterweights: problem
             .counterweights
             .iter()
             .zip(cws)
             .map(|(slot, p)| Counterweight {
-                body: slot.body,
+                label: slot.label.clone(),
+                body: name(slot.body),
                 mass: p.mass,
-                position: p.offset(),
+                offset: p.offset(),
+                plane: cw_plane,
             })
             .collect(),
         springs: springs
             .iter()
             .map(|s| Spring {
-                body: s.body,
+                label: s.label.clone(),
+                body: name(s.body),
                 other: match s.other {
-                    Attachment::Base => None,
-                    Attachment::Body(b) => Some(b),
+                    Attachment::Base => counterpoise_vocabulary::BASE.into(),
+                    Attachment::Body(b) => name(b),
                 },
                 stiffness: s.stiffness,
-                anchor: s.anchor_a,
-                other_anchor: s.anchor_b,
+                anchor_a: s.anchor_a,
+                anchor_b: s.anchor_b,
+                plane: spring_plane,
             })
             .collect(),
     }
@@ -85,7 +101,7 @@ pub(super) fn grid_indicators(
 ) -> Result<Vec<Indicators>, String> {
     let to_base: Vec<bool> = variants
         .iter()
-        .map(|v| v.springs.iter().any(|s| s.other.is_none()))
+        .map(|v| v.springs.iter().any(|s| s.to_base()))
         .collect();
     if to_base.iter().all(|&b| b) || to_base.iter().all(|&b| !b) {
         let n = variants.len();

@@ -152,7 +152,7 @@ fn critical_task_loop(
             timings.passes,
             evaluated.len(),
         );
-        let dyn_variants = candidate_variants(runs, &evaluated);
+        let dyn_variants = candidate_variants(&ctx.model, runs, &evaluated);
         let indicators = grid_indicators(ctx, &dyn_variants, false, &share);
         timings.loop_grid += started.elapsed();
         let indicators = match indicators {

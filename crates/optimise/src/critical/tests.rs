@@ -204,7 +204,7 @@ fn the_final_checks_decide_the_verdict() {
     let final_indicators = |run: &Run| {
         grid_indicators(
             &ctx,
-            &candidate_variants(std::slice::from_ref(run), &[0]),
+            &candidate_variants(&ctx.model, std::slice::from_ref(run), &[0]),
             true,
             &crate::progress::ShareCounter::start(
                 &crate::progress::silent,
@@ -313,7 +313,7 @@ fn the_spring_choice_keeps_the_lowest_delta_r_of_all_options() {
         );
         let variants: Vec<Variant> = found
             .iter()
-            .map(|(s, _)| dynamics_variant(problem, &cand.cws, s))
+            .map(|(s, _)| dynamics_variant(&ctx.model, problem, &cand.cws, s))
             .collect();
         let params = ParameterSet::from_variants(&ctx.model, &variants).unwrap();
         let grid = evaluate_grid(&ctx.model, &params, &EvaluateOptions::default()).unwrap();
@@ -505,17 +505,22 @@ fn a_search_without_a_design_has_four_times_the_box_budget() {
 fn batched_reaction_peaks_equal_each_group_on_its_own() {
     let model = model(&case_json("palletizer.json"));
     let ctx = Context::new(&model, None).unwrap();
+    let name = |body: usize| model.bodies[body].name.clone();
     let spring = |body: usize, other: Option<usize>, stiffness: f64| Spring {
-        body,
-        other,
+        label: "K".into(),
+        body: name(body),
+        other: other.map_or_else(|| "base".into(), name),
         stiffness,
-        anchor: [0.1, 0.02, 0.0],
-        other_anchor: [-0.05, 0.3, 0.0],
+        anchor_a: [0.1, 0.02, 0.0],
+        anchor_b: [-0.05, 0.3, 0.0],
+        plane: None,
     };
     let cw = |body: usize, mass: f64| Counterweight {
-        body,
+        label: "m".into(),
+        body: name(body),
         mass,
-        position: [-0.3, 0.05, 0.0],
+        offset: [-0.3, 0.05, 0.0],
+        plane: None,
     };
     let a = vec![
         Variant {
