@@ -167,7 +167,7 @@ fn bounds_and_overrides_are_respected() {
                 .map(|v| f(v).powi(2))
                 .sum::<f64>()
                 .sqrt();
-            let r_hi = if cw["entry"] == 1 { 0.2 } else { 0.4 };
+            let r_hi = if cw["label"] == "m2" { 0.2 } else { 0.4 };
             assert!((-1e-9..=1.5 * (1.0 + 1e-7)).contains(&m), "{cw}");
             assert!(r <= r_hi * (1.0 + 1e-6), "{cw}");
         }

@@ -65,6 +65,9 @@ pub struct CatalogueEntry {
     pub label: String,
     /// Human name: `counterweight on upper_arm`, `spring upper_arm–slider_v`.
     pub description: String,
+    /// Body names: the counterweight's body, or the spring's two (`base` for the ground), as
+    /// the element's physical parameters name them.
+    pub bodies: Vec<String>,
     /// Names of the lifted variables, e.g. `m4`, `m4·r4x`, `K43`, `K43·a43x`, `K43·a43x·b43y`.
     pub variables: Vec<String>,
     /// Energy per unit of each lifted variable (J per unit).
@@ -177,6 +180,7 @@ fn counterweight(energy: &MechanismEnergy, body: usize, axes: &[usize]) -> Catal
         },
         label: format!("m{n}"),
         description: format!("counterweight on {}", frame.name),
+        bodies: vec![frame.name.clone()],
         variables,
         energy: polys.into_iter().map(clean).collect(),
     }
@@ -190,7 +194,7 @@ fn spring(
 ) -> CatalogueEntry {
     let frame = &energy.bodies[body];
     let (other_frame, other_number, other_name) = match other {
-        Attachment::Base => (None, 0, "base".to_string()),
+        Attachment::Base => (None, 0, counterpoise_vocabulary::BASE.to_string()),
         Attachment::Body(s) => {
             let f = &energy.bodies[s];
             (Some((&f.rotation, &f.origin)), s + 1, f.name.clone())
@@ -224,6 +228,7 @@ fn spring(
         },
         label,
         description: format!("spring {}–{}", frame.name, other_name),
+        bodies: vec![frame.name.clone(), other_name],
         variables,
         energy: polys.into_iter().map(clean).collect(),
     }

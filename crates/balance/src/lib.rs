@@ -36,7 +36,7 @@ pub mod verify;
 pub use element::{Attachment, Catalogue, CatalogueEntry, CatalogueOptions, Element, Plane};
 pub use energy::{BodyFrame, MechanismEnergy};
 pub use model_input::{catalogue_options, mechanism_energy, realization_hints};
-pub use realize::{CounterweightParams, RealizationHints, SpringParams, Witness};
+pub use realize::{Counterweight, RealizationHints, Spring, Witness};
 pub use search::{
     Arithmetic, Class, Decision, ElementKind, SearchOptions, SearchReport, Status, VariantResult,
     decide, search,

@@ -14,9 +14,8 @@
 use counterpoise_model::sampling::SplitMix64;
 
 use nalgebra::{DMatrix, DVector};
-use serde::Serialize;
 
-use crate::element::{Attachment, CatalogueEntry, Element};
+use crate::element::{CatalogueEntry, Element};
 use crate::linear::LinearSolution;
 
 /// Scales that make starting points and witnesses plausible to a designer.
@@ -57,38 +56,13 @@ impl Default for RealizationHints {
     }
 }
 
-/// Physical parameters of one counterweight.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct CounterweightParams {
-    /// Catalogue entry.
-    pub entry: usize,
-    pub body: usize,
-    /// Mass (kg).
-    pub mass: f64,
-    /// Centre of mass in the body frame (m).
-    pub offset: [f64; 3],
-}
+/// The physical parameters of one counterweight and one spring: the shared types, named by
+/// catalogue label and body names.
+pub use counterpoise_vocabulary::{Counterweight, Spring};
 
-/// Physical parameters of one zero-free-length spring.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SpringParams {
-    pub entry: usize,
-    pub body: usize,
-    pub other: Attachment,
-    /// Stiffness (N/m).
-    pub stiffness: f64,
-    /// Anchor on `body`, in its frame (m).
-    pub anchor_a: [f64; 3],
-    /// Anchor on `other`, in its frame (m).
-    pub anchor_b: [f64; 3],
-}
-
-/// A physical parameter set for a variant.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct Witness {
-    pub counterweights: Vec<CounterweightParams>,
-    pub springs: Vec<SpringParams>,
-}
+/// A physical parameter set for a variant: the shared physical parameters, which the search
+/// verifies by sampling the energy before it reports them.
+pub use counterpoise_vocabulary::PhysicalParameters as Witness;
 
 /// Outcome of realization.
 #[derive(Clone, Debug)]
@@ -102,7 +76,6 @@ pub enum Realization {
 
 /// Layout of physical unknowns for one element of the variant.
 struct Slot<'a> {
-    entry_index: usize,
     entry: &'a CatalogueEntry,
     /// First lifted variable (column of `A_S`).
     column: usize,
@@ -204,9 +177,8 @@ pub fn find_witness_on(
 ) -> Result<Witness, String> {
     let mut slots = Vec::new();
     let mut unknowns = 0;
-    for (k, (entry_index, entry)) in entries.iter().enumerate() {
+    for (k, (_, entry)) in entries.iter().enumerate() {
         slots.push(Slot {
-            entry_index: *entry_index,
             entry,
             column: solution.offsets[k],
             unknown: unknowns,
@@ -694,25 +666,21 @@ impl Problem<'_> {
         let mut witness = Witness::default();
         for slot in self.slots {
             match &slot.entry.element {
-                Element::Counterweight { body, axes } => {
+                Element::Counterweight { axes, .. } => {
                     let mass = y[slot.unknown].exp();
                     let mut offset = [0.0; 3];
                     for (k, &axis) in axes.iter().enumerate() {
                         offset[axis] = y[slot.unknown + 1 + k] / mass;
                     }
-                    witness.counterweights.push(CounterweightParams {
-                        entry: slot.entry_index,
-                        body: *body,
+                    witness.counterweights.push(Counterweight {
+                        label: slot.entry.label.clone(),
+                        body: slot.entry.bodies[0].clone(),
                         mass,
                         offset,
+                        plane: None,
                     });
                 }
-                Element::Spring {
-                    body,
-                    other,
-                    axes_a,
-                    axes_b,
-                } => {
+                Element::Spring { axes_a, axes_b, .. } => {
                     let mut anchor_a = [0.0; 3];
                     let mut anchor_b = [0.0; 3];
                     for (k, &axis) in axes_a.iter().enumerate() {
@@ -721,13 +689,14 @@ impl Problem<'_> {
                     for (l, &axis) in axes_b.iter().enumerate() {
                         anchor_b[axis] = y[slot.unknown + 1 + axes_a.len() + l];
                     }
-                    witness.springs.push(SpringParams {
-                        entry: slot.entry_index,
-                        body: *body,
-                        other: *other,
+                    witness.springs.push(Spring {
+                        label: slot.entry.label.clone(),
+                        body: slot.entry.bodies[0].clone(),
+                        other: slot.entry.bodies[1].clone(),
                         stiffness: y[slot.unknown].exp(),
                         anchor_a,
                         anchor_b,
+                        plane: None,
                     });
                 }
             }

@@ -616,7 +616,7 @@ fn element_ref(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::realize::CounterweightParams;
+    use crate::realize::Counterweight;
     use counterpoise_symbolic::{PolyMat3, PolyVec3, TrigPoly, VarKind};
 
     /// A rod of mass 2 kg with its centre 0.5 m out, hinged about z under gravity −y:
@@ -713,6 +713,7 @@ mod tests {
             },
             label: "K1".into(),
             description: "a spring".into(),
+            bodies: vec!["rod".into(), "base".into()],
             variables: Vec::new(),
             energy: Vec::new(),
         };
@@ -791,6 +792,7 @@ mod tests {
             },
             label: "K1".into(),
             description: "a spring".into(),
+            bodies: vec!["rod".into(), "base".into()],
             variables: Vec::new(),
             energy: Vec::new(),
         };
@@ -862,6 +864,7 @@ mod tests {
                 },
                 label: "K1".into(),
                 description: "spring rod–base".into(),
+                bodies: vec!["rod".into(), "base".into()],
                 variables: names,
                 energy: Vec::new(),
             }],
@@ -890,11 +893,12 @@ mod tests {
         for (moment, status) in [(-1.0, Status::Balanced), (-0.9, Status::Undecided)] {
             let mut result = fresh(&energy);
             let witness = Witness {
-                counterweights: vec![CounterweightParams {
-                    entry: 0,
-                    body: 0,
+                counterweights: vec![Counterweight {
+                    label: "m1".into(),
+                    body: "rod".into(),
                     mass: 2.0,
                     offset: [moment / 2.0, 0.0, 0.0],
+                    plane: None,
                 }],
                 springs: Vec::new(),
             };
@@ -917,11 +921,12 @@ mod tests {
         let mut result = fresh(&energy);
         result.idle.push("m1".into());
         let witness = Witness {
-            counterweights: vec![CounterweightParams {
-                entry: 0,
-                body: 0,
+            counterweights: vec![Counterweight {
+                label: "m1".into(),
+                body: "rod".into(),
                 mass: 2.0,
                 offset: [-0.5, 0.0, 0.0],
+                plane: None,
             }],
             springs: Vec::new(),
         };

@@ -7,7 +7,6 @@
 use counterpoise_symbolic::Point;
 use serde::Serialize;
 
-use crate::element::Attachment;
 use crate::energy::MechanismEnergy;
 use crate::realize::Witness;
 use counterpoise_model::sampling::SplitMix64;
@@ -55,6 +54,8 @@ type Pose = ([[f64; 3]; 3], [f64; 3]);
 #[derive(Clone, Debug)]
 pub struct VerificationSet {
     poses: Vec<Vec<Pose>>,
+    /// Body names in the order of each sample's poses.
+    bodies: Vec<String>,
     unbalanced: Vec<f64>,
     gravity: [f64; 3],
     unbalanced_spread: f64,
@@ -77,6 +78,7 @@ impl VerificationSet {
         let (lo, hi) = spread(&unbalanced);
         VerificationSet {
             poses,
+            bodies: energy.bodies.iter().map(|b| b.name.clone()).collect(),
             unbalanced,
             gravity: energy.gravity,
             unbalanced_spread: hi - lo,
@@ -89,7 +91,7 @@ impl VerificationSet {
             .poses
             .iter()
             .zip(&self.unbalanced)
-            .map(|(poses, v_ub)| v_ub + element_energy(poses, self.gravity, witness))
+            .map(|(poses, v_ub)| v_ub + element_energy(poses, &self.bodies, self.gravity, witness))
             .collect();
         let (lo, hi) = spread(&totals);
         let residual = if self.unbalanced_spread > 0.0 {
@@ -113,25 +115,38 @@ fn spread(values: &[f64]) -> (f64, f64) {
         })
 }
 
-/// Potential energy of the witness's elements alone, given every body's numeric pose.
-pub fn element_energy(poses: &[Pose], gravity: [f64; 3], witness: &Witness) -> f64 {
+/// Potential energy of the witness's elements alone, given every body's numeric pose (`bodies`
+/// names them, in the same order). An element on a body that is not there has no energy: NaN,
+/// which no verification passes.
+pub fn element_energy(
+    poses: &[Pose],
+    bodies: &[String],
+    gravity: [f64; 3],
+    witness: &Witness,
+) -> f64 {
+    let pose = |name: &str| bodies.iter().position(|b| b == name).map(|i| &poses[i]);
     let mut total = 0.0;
     for cw in &witness.counterweights {
-        let (r, p) = &poses[cw.body];
+        let Some((r, p)) = pose(&cw.body) else {
+            return f64::NAN;
+        };
         let offset = apply(r, cw.offset);
         let position = [p[0] + offset[0], p[1] + offset[1], p[2] + offset[2]];
         total -= cw.mass * dot(gravity, position);
     }
     for spring in &witness.springs {
-        let (r_i, p_i) = &poses[spring.body];
+        let Some((r_i, p_i)) = pose(&spring.body) else {
+            return f64::NAN;
+        };
         let a = apply(r_i, spring.anchor_a);
-        let b = match spring.other {
-            Attachment::Base => spring.anchor_b,
-            Attachment::Body(s) => {
-                let (r_s, p_s) = &poses[s];
-                let b = apply(r_s, spring.anchor_b);
-                [p_s[0] + b[0], p_s[1] + b[1], p_s[2] + b[2]]
-            }
+        let b = if spring.to_base() {
+            spring.anchor_b
+        } else {
+            let Some((r_s, p_s)) = pose(&spring.other) else {
+                return f64::NAN;
+            };
+            let b = apply(r_s, spring.anchor_b);
+            [p_s[0] + b[0], p_s[1] + b[1], p_s[2] + b[2]]
         };
         let d: [f64; 3] = std::array::from_fn(|k| p_i[k] + a[k] - b[k]);
         total += 0.5 * spring.stiffness * dot(d, d);
@@ -143,7 +158,7 @@ pub fn element_energy(poses: &[Pose], gravity: [f64; 3], witness: &Witness) -> f
 mod tests {
     use super::*;
     use crate::energy::BodyFrame;
-    use crate::realize::CounterweightParams;
+    use crate::realize::{Counterweight, Spring};
     use counterpoise_symbolic::{LinearAngle, PolyMat3, PolyVec3, TrigPoly, VarKind};
 
     /// A turntable: one body turning about z, with gravity along z. Its unbalanced energy is zero
@@ -166,7 +181,6 @@ mod tests {
 
     #[test]
     fn element_energy_matches_a_hand_calculation() {
-        use crate::realize::SpringParams;
         // Body 0 turned a quarter turn about z and moved to (1, 2, 3); body 1 unturned at
         // (0, 0, 1). Gravity (−1, −2, −3) has a component along every axis.
         let quarter = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
@@ -175,35 +189,40 @@ mod tests {
         let gravity = [-1.0, -2.0, -3.0];
         // 2 kg at (0.5, 0.25, −1) on body 0: R·r = (−0.25, 0.5, −1), world (0.75, 2.5, 2),
         // g·x = −0.75 − 5 − 6 = −11.75, energy −m g·x = 23.5 J.
-        let counterweight = CounterweightParams {
-            entry: 0,
-            body: 0,
+        let bodies = ["zero".to_string(), "one".to_string()];
+        let counterweight = Counterweight {
+            label: "m1".into(),
+            body: "zero".into(),
             mass: 2.0,
             offset: [0.5, 0.25, -1.0],
+            plane: None,
         };
         // K = 4 from (1, 0, 0) on body 0 — world (1, 2, 3) + (0, 1, 0) = (1, 3, 3) — to (0, 0, 2)
         // on body 1 — world (0, 0, 3): d = (1, 3, 0), |d|² = 10, energy 4/2·10 = 20 J.
-        let between = SpringParams {
-            entry: 1,
-            body: 0,
-            other: Attachment::Body(1),
+        let between = Spring {
+            label: "K12".into(),
+            body: "zero".into(),
+            other: "one".into(),
             stiffness: 4.0,
             anchor_a: [1.0, 0.0, 0.0],
             anchor_b: [0.0, 0.0, 2.0],
+            plane: None,
         };
         // K = 3 from (1, 1, 0) on body 1 — world (1, 1, 1) — to the base point (1, 1, −1):
         // d = (0, 0, 2), energy 3/2·4 = 6 J.
-        let to_base = SpringParams {
-            entry: 2,
-            body: 1,
-            other: Attachment::Base,
+        let to_base = Spring {
+            label: "K20".into(),
+            body: "one".into(),
+            other: "base".into(),
             stiffness: 3.0,
             anchor_a: [1.0, 1.0, 0.0],
             anchor_b: [1.0, 1.0, -1.0],
+            plane: None,
         };
-        let alone = |counterweights: Vec<CounterweightParams>, springs: Vec<SpringParams>| {
+        let alone = |counterweights: Vec<Counterweight>, springs: Vec<Spring>| {
             element_energy(
                 &poses,
+                &bodies,
                 gravity,
                 &Witness {
                     counterweights,
@@ -215,9 +234,20 @@ mod tests {
         assert_eq!(alone(vec![], vec![between.clone()]), 20.0);
         assert_eq!(alone(vec![], vec![to_base.clone()]), 6.0);
         assert_eq!(
-            alone(vec![counterweight], vec![between, to_base]),
+            alone(vec![counterweight.clone()], vec![between, to_base.clone()]),
             23.5 + 20.0 + 6.0
         );
+        // An element on a body the mechanism does not have is never balanced.
+        let elsewhere = Counterweight {
+            body: "two".into(),
+            ..counterweight
+        };
+        assert!(alone(vec![elsewhere], vec![]).is_nan());
+        let to_nowhere = Spring {
+            other: "two".into(),
+            ..to_base
+        };
+        assert!(alone(vec![], vec![to_nowhere]).is_nan());
     }
 
     #[test]
@@ -227,11 +257,12 @@ mod tests {
         // height 0.5 m whatever the angle, so its energy is −m·g·z = 2·9.81·0.5 = 9.81 J at every
         // sample, and the total energy does not spread at all.
         let witness = Witness {
-            counterweights: vec![CounterweightParams {
-                entry: 0,
-                body: 0,
+            counterweights: vec![Counterweight {
+                label: "m1".into(),
+                body: "table".into(),
                 mass: 2.0,
                 offset: [0.3, 0.0, 0.5],
+                plane: None,
             }],
             springs: Vec::new(),
         };

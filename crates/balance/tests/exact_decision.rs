@@ -213,20 +213,20 @@ fn idle_elements_contribute_no_energy() {
         for label in &v.idle {
             let energy_at = |q: &DVector<f64>| -> f64 {
                 let poses = kinematics.body_poses(q);
-                let entry = v.elements.iter().find(|e| &e.label == label).unwrap().entry;
-                if let Some(c) = w.counterweights.iter().find(|c| c.entry == entry) {
-                    let p = &poses[c.body];
+                let body = |name: &str| model.body_index(name).unwrap();
+                if let Some(c) = w.counterweights.iter().find(|c| &c.label == label) {
+                    let p = &poses[body(&c.body)];
                     let at = p.position + p.rotation * Vector3::from(c.offset);
                     return -c.mass * g.dot(&at);
                 }
-                let s = w.springs.iter().find(|s| s.entry == entry).unwrap();
-                let p = &poses[s.body];
+                let s = w.springs.iter().find(|s| &s.label == label).unwrap();
+                let p = &poses[body(&s.body)];
                 let a = p.position + p.rotation * Vector3::from(s.anchor_a);
-                let b = match s.other {
-                    counterpoise_balance::Attachment::Base => Vector3::from(s.anchor_b),
-                    counterpoise_balance::Attachment::Body(o) => {
-                        poses[o].position + poses[o].rotation * Vector3::from(s.anchor_b)
-                    }
+                let b = if s.to_base() {
+                    Vector3::from(s.anchor_b)
+                } else {
+                    let o = &poses[body(&s.other)];
+                    o.position + o.rotation * Vector3::from(s.anchor_b)
                 };
                 0.5 * s.stiffness * (a - b).norm_squared()
             };

@@ -5,8 +5,7 @@ mod common;
 use common::{find, palletizer, run};
 use counterpoise_balance::verify::element_energy;
 use counterpoise_balance::{
-    Attachment, Class, CounterweightParams, Decision, MechanismEnergy, SpringParams, Status,
-    Witness, mechanism_energy,
+    Class, Counterweight, Decision, MechanismEnergy, Spring, Status, Witness, mechanism_energy,
 };
 use counterpoise_model::Model;
 use counterpoise_model::sampling::SplitMix64;
@@ -30,7 +29,8 @@ fn relative_spread(model: &Model, energy: &MechanismEnergy, witness: &Witness, s
             .collect();
         let v = energy.unbalanced.eval(&at);
         ub.push(v);
-        total.push(v + element_energy(&poses, energy.gravity, witness));
+        let names: Vec<String> = model.bodies.iter().map(|b| b.name.clone()).collect();
+        total.push(v + element_energy(&poses, &names, energy.gravity, witness));
     }
     let spread = |v: &[f64]| {
         v.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
@@ -136,12 +136,14 @@ fn polar(r: f64, angle: f64) -> [f64; 3] {
     [r * angle.cos(), r * angle.sin(), 0.0]
 }
 
-fn cw(model: &Model, body: &str, mass: f64, r_mm: f64, phi: f64) -> CounterweightParams {
-    CounterweightParams {
-        entry: 0,
-        body: model.body_index(body).unwrap(),
+fn cw(model: &Model, body: &str, mass: f64, r_mm: f64, phi: f64) -> Counterweight {
+    assert!(model.body_index(body).is_some(), "{body}");
+    Counterweight {
+        label: format!("m on {body}"),
+        body: body.into(),
         mass,
         offset: polar(r_mm * 1e-3, phi),
+        plane: None,
     }
 }
 
@@ -155,14 +157,19 @@ fn spring(
     alpha: f64,
     b: f64,
     beta: f64,
-) -> SpringParams {
-    SpringParams {
-        entry: 0,
-        body: model.body_index(i).unwrap(),
-        other: Attachment::Body(model.body_index(s).unwrap()),
+) -> Spring {
+    assert!(
+        model.body_index(i).is_some() && model.body_index(s).is_some(),
+        "{i} {s}"
+    );
+    Spring {
+        label: format!("K {i}–{s}"),
+        body: i.into(),
+        other: s.into(),
         stiffness: k * 1e3,
         anchor_a: polar(a * 1e-3, alpha),
         anchor_b: polar(b * 1e-3, beta),
+        plane: None,
     }
 }
 

@@ -176,6 +176,11 @@ type SpringForce = (usize, Vector3<f64>, Attachment, Vector3<f64>, f64);
 /// pulls its anchor on `body` (world `p_A = p_i + R_i a`) with `−K(p_A − p_B)`, so holding it
 /// needs `F = K(p_A − p_B)` applied at `p_A` (the moment `(R_i a) × F` about the body origin),
 /// and `−F` at `p_B` on the other body (nothing on the base).
+/// The index of a body the design names.
+fn body(model: &Model, name: &str) -> usize {
+    model.body_index(name).expect("a body of the model")
+}
+
 fn static_forces_with(
     model: &Model,
     q: &[f64],
@@ -229,16 +234,22 @@ fn recomputed_rms(model: &Model, qs: &[Vec<f64>], design: &PartialDesign) -> Vec
     let extra: Vec<_> = design
         .counterweights
         .iter()
-        .map(|c| (c.body, c.mass, Vector3::from(c.offset)))
+        .map(|c| (body(model, &c.body), c.mass, Vector3::from(c.offset)))
         .collect();
     let springs: Vec<_> = design
         .springs
         .iter()
-        .map(|s| {
+        .map(|p| {
+            let s = &p.spring;
+            let other = if s.to_base() {
+                Attachment::Base
+            } else {
+                Attachment::Body(body(model, &s.other))
+            };
             (
-                s.body,
+                body(model, &s.body),
                 Vector3::from(s.anchor_a),
-                s.other,
+                other,
                 Vector3::from(s.anchor_b),
                 s.stiffness,
             )
@@ -482,7 +493,7 @@ fn arm6_conic_optimum_matches_the_normal_equations() {
             for r in [Vector3::zeros(), Vector3::x(), Vector3::y(), Vector3::z()] {
                 let mut col = Vec::new();
                 for (q, ub) in qs.iter().zip(&unbalanced) {
-                    let f = static_forces(model, q, &[(c.body, 1.0, r)]) - ub;
+                    let f = static_forces(model, q, &[(body(model, &c.body), 1.0, r)]) - ub;
                     col.extend(joints.iter().map(|&j| f[j]));
                 }
                 columns.push(col);
@@ -646,15 +657,15 @@ fn pendulum_spring_below_balance_matches_the_closed_form() {
         (G - 5.0) / G,
         1e-6
     ));
-    let s = &best.springs[0];
-    assert_eq!(s.other, Attachment::Base);
+    let (s, torque_rms) = (&best.springs[0].spring, best.springs[0].torque_rms);
+    assert!(s.to_base(), "{s:?}");
     // every bound active: only K = 100 N/m, |a| = 0.1 m, |b| = 0.5 m give 5 N·m
     assert!(close(s.stiffness, 100.0, 1e-5), "{s:?}");
     assert!(close(norm(&s.anchor_a), 0.1, 1e-5), "{s:?}");
     assert!(close(norm(&s.anchor_b), 0.5, 1e-5), "{s:?}");
     let (cross, dot) = cross_dot(&s.anchor_a, &s.anchor_b);
     assert!(close(cross, 0.05, 1e-5) && dot.abs() < 1e-6, "{s:?}");
-    assert!(close(s.torque_rms, 5.0 * mean_cos, 1e-5), "{s:?}");
+    assert!(close(torque_rms, 5.0 * mean_cos, 1e-5), "{s:?}");
     assert!(best.certified, "{best:?}");
     assert!(best.lower_bound <= best.total_rms * (1.0 + 1e-9));
     assert!(close(best.lower_bound, expected, 1e-5), "{best:?}");
@@ -681,7 +692,7 @@ fn pendulum_spring_balances_when_the_bounds_allow_it() {
     let best = &report.designs[0];
     assert!(best.total_rms < 1e-6 * report.unbalanced_total, "{best:?}");
     assert!(best.certified);
-    let s = &best.springs[0];
+    let s = &best.springs[0].spring;
     let (cross, _) = cross_dot(&s.anchor_a, &s.anchor_b);
     assert!(close(s.stiffness * cross, G, 1e-6), "{s:?}");
     assert!(close(s.stiffness, 98.1, 1e-4), "{s:?}");
@@ -729,7 +740,7 @@ fn two_link_springs_bound_below_and_recomputed() {
             d.lower_bound,
             d.total_rms
         );
-        for s in &d.springs {
+        for s in d.springs.iter().map(|p| &p.spring) {
             with_springs += 1;
             assert!(
                 (10.0 * (1.0 - 1e-7)..=200.0 * (1.0 + 1e-7)).contains(&s.stiffness),

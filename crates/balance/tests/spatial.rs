@@ -63,7 +63,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use counterpoise_balance::{
     Attachment, BodyFrame, Catalogue, CatalogueOptions, MechanismEnergy, RealizationHints,
-    SearchOptions, SearchReport, SpringParams, Status, VariantResult, search,
+    SearchOptions, SearchReport, Status, VariantResult, search,
 };
 use counterpoise_symbolic::{LinearAngle, Point, PolyMat3, PolyVec3, TrigPoly, VarKind};
 
@@ -162,11 +162,14 @@ struct Spring {
     anchor_b: Vec3,
 }
 
-impl From<&SpringParams> for Spring {
-    fn from(s: &SpringParams) -> Spring {
-        assert_eq!(s.other, Attachment::Base, "{s:?}");
+/// The bodies of [`energy`]'s mechanism, in order.
+const LINKS: [&str; 2] = ["pitch_link", "roll_link"];
+
+impl From<&counterpoise_balance::Spring> for Spring {
+    fn from(s: &counterpoise_balance::Spring) -> Spring {
+        assert!(s.to_base(), "{s:?}");
         Spring {
-            body: s.body,
+            body: LINKS.iter().position(|&l| l == s.body).expect("a link"),
             stiffness: s.stiffness,
             anchor_a: s.anchor_a,
             anchor_b: s.anchor_b,
@@ -483,7 +486,7 @@ fn search_balances_pitch_roll_arm_with_two_base_springs() {
                 witness
                     .springs
                     .iter()
-                    .find(|s| s.body == body)
+                    .find(|s| s.body == LINKS[body])
                     .expect("one spring per link"),
             )
         };

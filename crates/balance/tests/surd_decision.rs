@@ -302,7 +302,13 @@ fn the_spherical_chain_is_decided_with_nothing_undecided() {
 /// 9.81 along −z; a counterweight adds `m g z`, a spring `K/2·|p_i + R_i a − p_j − R_j b|²` (the
 /// base: `p = 0`, `R = I`).
 fn leg_energy(witness: &counterpoise_balance::Witness, q: &[f64; 3]) -> f64 {
-    use counterpoise_balance::Attachment;
+    // The chains of tests/data/three_chain_leg.json, by name.
+    let chain = |name: &str| {
+        ["link1", "link2", "link3"]
+            .iter()
+            .position(|&l| l == name)
+            .unwrap()
+    };
     let theta = [
         0.0,
         2.0 * std::f64::consts::PI / 3.0,
@@ -320,13 +326,14 @@ fn leg_energy(witness: &counterpoise_balance::Witness, q: &[f64; 3]) -> f64 {
         .map(|k| 1.2 * g * frame(k, [0.25, 0.0, 0.0])[2])
         .sum();
     for c in &witness.counterweights {
-        energy += c.mass * g * frame(c.body, c.offset)[2];
+        energy += c.mass * g * frame(chain(&c.body), c.offset)[2];
     }
     for s in &witness.springs {
-        let a = frame(s.body, s.anchor_a);
-        let b = match s.other {
-            Attachment::Base => s.anchor_b,
-            Attachment::Body(j) => frame(j, s.anchor_b),
+        let a = frame(chain(&s.body), s.anchor_a);
+        let b = if s.to_base() {
+            s.anchor_b
+        } else {
+            frame(chain(&s.other), s.anchor_b)
         };
         let d2: f64 = (0..3).map(|i| (a[i] - b[i]).powi(2)).sum();
         energy += 0.5 * s.stiffness * d2;

@@ -134,6 +134,7 @@ mod tests {
             label: "K21".into(),
             body: 1,
             other: Attachment::Body(0),
+            bodies: ["link2".into(), "link1".into()],
             axes_a: vec![0, 1],
             axes_b: vec![0, 1],
             column,

@@ -123,6 +123,7 @@ impl VariantProblem {
                     label: entry.label.clone(),
                     body: *body,
                     other: *other,
+                    bodies: [entry.bodies[0].clone(), entry.bodies[1].clone()],
                     axes_a: axes_a.clone(),
                     axes_b: axes_b.clone(),
                     column,

@@ -43,6 +43,9 @@ pub struct SpringSlot {
     pub label: String,
     pub body: usize,
     pub other: Attachment,
+    /// The names of `body` and `other` (`base` for the ground), as the spring's physical
+    /// parameters name them.
+    pub bodies: [String; 2],
     pub axes_a: Vec<usize>,
     pub axes_b: Vec<usize>,
     pub column: usize,

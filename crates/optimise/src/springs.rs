@@ -11,27 +11,14 @@
 //! sets; since massless springs never change a balanced variant's motor torques, the one with
 //! the lowest joint-reaction indicator ΔR (paper Eqs. 17–21) on the reaction tasks is kept.
 
-use counterpoise_balance::Attachment;
 use counterpoise_model::sampling::SplitMix64;
 use nalgebra::{DMatrix, DVector};
-use serde::Serialize;
 
 use crate::problem::{VariantProblem, norm};
 
-/// Physical parameters of one spring.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SpringValues {
-    pub entry: usize,
-    pub label: String,
-    pub body: usize,
-    pub other: Attachment,
-    /// N/m.
-    pub stiffness: f64,
-    /// m, body frame of `body`.
-    pub anchor_a: [f64; 3],
-    /// m, frame of `other`.
-    pub anchor_b: [f64; 3],
-}
+/// The physical parameters of one realized spring: the shared type (named by catalogue label
+/// and body names, in the order of the problem's spring slots).
+pub use counterpoise_vocabulary::Spring;
 
 /// Relative balance residual accepted from the local solve (the energy sampling is the real
 /// check).
@@ -368,7 +355,7 @@ fn levenberg_marquardt(
 }
 
 /// Physical springs at `y`.
-fn values(problem: &VariantProblem, lay: &Layout, y: &DVector<f64>) -> Vec<SpringValues> {
+fn values(problem: &VariantProblem, lay: &Layout, y: &DVector<f64>) -> Vec<Spring> {
     problem
         .springs
         .iter()
@@ -384,21 +371,21 @@ fn values(problem: &VariantProblem, lay: &Layout, y: &DVector<f64>) -> Vec<Sprin
             for (l, &ax) in s.axes_b.iter().enumerate() {
                 anchor_b[ax] = y[u + 1 + na + l];
             }
-            SpringValues {
-                entry: s.entry,
+            Spring {
                 label: s.label.clone(),
-                body: s.body,
-                other: s.other,
+                body: s.bodies[0].clone(),
+                other: s.bodies[1].clone(),
                 stiffness: y[u].exp(),
                 anchor_a,
                 anchor_b,
+                plane: None,
             }
         })
         .collect()
 }
 
 /// One admissible spring set and the full lifted point with it.
-pub type Realized = (Vec<SpringValues>, DVector<f64>);
+pub type Realized = (Vec<Spring>, DVector<f64>);
 
 /// The local solves of one [`realize_springs_reusing`] call: the lifted point they ran for and,
 /// per start, the point reached with its balance residual and bound excess.

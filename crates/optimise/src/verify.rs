@@ -2,12 +2,13 @@
 //! balance crate's verification configurations, relative spread ≤ 1e-9), every bound (relative
 //! excess ≤ 1e-9) and every peak limit over all tasks (from the final dynamics evaluation).
 
-use counterpoise_balance::{CounterweightParams, SpringParams, VerificationSet, Witness};
+use counterpoise_balance::VerificationSet;
 use counterpoise_dynamics::Indicators;
+use counterpoise_vocabulary::PhysicalParameters;
 use serde::Serialize;
 
 use crate::problem::{CwPhysical, VariantProblem, norm};
-use crate::springs::SpringValues;
+use crate::springs::Spring;
 
 /// Relative tolerance of the bound and peak checks.
 pub const CHECK_TOL: f64 = 1e-9;
@@ -36,41 +37,13 @@ pub struct VerificationReport {
     pub passed: bool,
 }
 
-/// The balance crate's witness of the optimised parameters.
-pub fn witness(problem: &VariantProblem, cws: &[CwPhysical], springs: &[SpringValues]) -> Witness {
-    Witness {
-        counterweights: problem
-            .counterweights
-            .iter()
-            .zip(cws)
-            .map(|(c, p)| CounterweightParams {
-                entry: c.entry,
-                body: c.body,
-                mass: p.mass,
-                offset: p.offset(),
-            })
-            .collect(),
-        springs: springs
-            .iter()
-            .map(|s| SpringParams {
-                entry: s.entry,
-                body: s.body,
-                other: s.other,
-                stiffness: s.stiffness,
-                anchor_a: s.anchor_a,
-                anchor_b: s.anchor_b,
-            })
-            .collect(),
-    }
-}
-
 fn excess(value: f64, range: [f64; 2]) -> f64 {
     let scale = range[1].abs().max(1e-12);
     ((range[0] - value) / scale).max((value - range[1]) / scale)
 }
 
 /// Largest relative bound excess of physical parameters.
-pub fn bound_excess(problem: &VariantProblem, cws: &[CwPhysical], springs: &[SpringValues]) -> f64 {
+pub fn bound_excess(problem: &VariantProblem, cws: &[CwPhysical], springs: &[Spring]) -> f64 {
     let mut worst = f64::NEG_INFINITY;
     for (c, p) in problem.counterweights.iter().zip(cws) {
         worst = worst.max(excess(p.mass, [c.min_mass(), c.bounds.mass[1]]));
@@ -98,14 +71,17 @@ pub fn bound_excess(problem: &VariantProblem, cws: &[CwPhysical], springs: &[Spr
     worst
 }
 
+/// Checks the optimised point: the balance of `elements` (the physical parameters of `cws` and
+/// `springs`, named) by energy sampling, the bounds and the peak limits.
 pub fn verify(
     problem: &VariantProblem,
     checks: &VerificationSet,
+    elements: &PhysicalParameters,
     cws: &[CwPhysical],
-    springs: &[SpringValues],
+    springs: &[Spring],
     indicators: &Indicators,
 ) -> VerificationReport {
-    let balance = checks.verify(&witness(problem, cws, springs));
+    let balance = checks.verify(elements);
     let bound_excess = bound_excess(problem, cws, springs);
     let peaks: Vec<PeakCheck> = indicators
         .actuators

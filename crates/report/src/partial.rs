@@ -9,6 +9,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::format::fixed;
+use crate::parameters::Counterweight;
 
 /// Rows of the designs table in the reports; every set is in partial.json and partial.csv.
 pub const TABLE_ROWS: usize = 30;
@@ -57,16 +58,11 @@ pub struct PartialDesign {
     pub exact: Option<String>,
 }
 
-/// One counterweight of a design.
+/// One counterweight of a design: its physical parameters, and whether the design uses it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PartialElement {
-    pub label: String,
-    /// The body it is fixed to.
-    pub body: String,
-    /// kg.
-    pub mass: f64,
-    /// Centre of mass in the body frame, m.
-    pub offset: [f64; 3],
+    #[serde(flatten)]
+    pub counterweight: Counterweight,
     /// Left at 0 kg by the best design (the smaller set does as well).
     pub unused: bool,
 }
@@ -76,7 +72,7 @@ impl PartialDesign {
     pub fn set(&self) -> String {
         self.elements
             .iter()
-            .map(|e| e.label.as_str())
+            .map(|e| e.counterweight.label.as_str())
             .collect::<Vec<_>>()
             .join(" + ")
     }
@@ -113,17 +109,26 @@ fn millimetres(metres: f64) -> String {
 /// One counterweight in words: `m2 on upper_arm: 13.405 kg at (0.0, 0.0, -425.5) mm (|r| = 425.5 mm)`.
 pub fn element_text(e: &PartialElement) -> String {
     if e.unused {
-        return format!("{} on {}: unused (0 kg)", e.label, e.body);
+        return format!(
+            "{} on {}: unused (0 kg)",
+            e.counterweight.label, e.counterweight.body
+        );
     }
-    let r = e.offset.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let r = e
+        .counterweight
+        .offset
+        .iter()
+        .map(|v| v * v)
+        .sum::<f64>()
+        .sqrt();
     format!(
         "{} on {}: {} kg at ({}, {}, {}) mm (|r| = {} mm)",
-        e.label,
-        e.body,
-        fixed(e.mass, 3),
-        millimetres(e.offset[0]),
-        millimetres(e.offset[1]),
-        millimetres(e.offset[2]),
+        e.counterweight.label,
+        e.counterweight.body,
+        fixed(e.counterweight.mass, 3),
+        millimetres(e.counterweight.offset[0]),
+        millimetres(e.counterweight.offset[1]),
+        millimetres(e.counterweight.offset[2]),
         millimetres(r)
     )
 }
@@ -196,10 +201,13 @@ pub(crate) mod tests {
 
     fn element(label: &str, mass: f64, unused: bool) -> PartialElement {
         PartialElement {
-            label: label.into(),
-            body: "link".into(),
-            mass,
-            offset: [0.0, 0.0, -0.4255],
+            counterweight: Counterweight {
+                label: label.into(),
+                body: "link".into(),
+                mass,
+                offset: [0.0, 0.0, -0.4255],
+                plane: None,
+            },
             unused,
         }
     }

@@ -5,8 +5,8 @@ use std::time::Instant;
 
 use counterpoise_balance::minimal::{MinimalReport, estimate_tested, minimal_search};
 use counterpoise_balance::{
-    Arithmetic, Attachment, Catalogue, Class, Decision, SearchOptions, SearchReport, Status,
-    VariantResult, catalogue_options, mechanism_energy, realization_hints, search,
+    Arithmetic, Catalogue, Class, Decision, SearchOptions, SearchReport, Status, VariantResult,
+    catalogue_options, mechanism_energy, realization_hints, search,
 };
 use counterpoise_model::limits::{Limit, format_count};
 use counterpoise_model::{Model, ModelError, Plane};
@@ -129,12 +129,6 @@ pub fn witness_lines(model: &Model, v: &VariantResult) -> Vec<String> {
         return Vec::new();
     };
     let mut lines = Vec::new();
-    let label = |entry: usize| {
-        v.elements
-            .iter()
-            .find(|e| e.entry == entry)
-            .map_or("?", |e| e.label.as_str())
-    };
     let balancing = model.balancing.as_ref();
     let cw_plane = balancing
         .and_then(|b| b.counterweights.as_ref())
@@ -146,30 +140,26 @@ pub fn witness_lines(model: &Model, v: &VariantResult) -> Vec<String> {
         let (r, phi) = polar(cw.offset, cw_plane);
         lines.push(format!(
             "{:<5} m = {:.3} kg, r = {:.1} mm, φ = {:.4} rad   (on {})",
-            label(cw.entry),
+            cw.label,
             cw.mass,
             r * 1e3,
             phi,
-            model.bodies[cw.body].name
+            cw.body
         ));
     }
     for s in &w.springs {
         let (a, alpha) = polar(s.anchor_a, spring_plane);
         let (b, beta) = polar(s.anchor_b, spring_plane);
-        let other = match s.other {
-            Attachment::Base => "base".to_string(),
-            Attachment::Body(i) => model.bodies[i].name.clone(),
-        };
         lines.push(format!(
             "{:<5} K = {:.4} N/mm, a = {:.1} mm, α = {:.4} rad, b = {:.1} mm, β = {:.4} rad   ({}–{})",
-            label(s.entry),
+            s.label,
             s.stiffness * 1e-3,
             a * 1e3,
             alpha,
             b * 1e3,
             beta,
-            model.bodies[s.body].name,
-            other
+            s.body,
+            s.other
         ));
     }
     lines

@@ -129,6 +129,7 @@ mod tests {
             },
             label: "K1".into(),
             description: "a spring".into(),
+            bodies: vec!["rod".into(), "base".into()],
             variables: Vec::new(),
             energy: Vec::new(),
         };

@@ -225,6 +225,7 @@ mod tests {
             },
             label: "K1".into(),
             description: "spring".into(),
+            bodies: vec!["rod".into(), "base".into()],
             variables: Vec::new(),
             energy: Vec::new(),
         }
@@ -238,6 +239,7 @@ mod tests {
             },
             label: "m1".into(),
             description: "counterweight".into(),
+            bodies: vec!["rod".into()],
             variables: Vec::new(),
             energy: Vec::new(),
         }

@@ -425,6 +425,7 @@ mod tests {
             },
             label: "K1".into(),
             description: "spring".into(),
+            bodies: vec!["rod".into(), "base".into()],
             variables: Vec::new(),
             energy: Vec::new(),
         }

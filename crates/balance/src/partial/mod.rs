@@ -28,9 +28,9 @@ use serde::Serialize;
 pub use counterweights::CounterweightLimits;
 pub use torque::{TorqueBasis, Workspace};
 
-use crate::element::{Attachment, Catalogue, Element};
+use crate::element::{Catalogue, Element};
 use crate::enumerate::variants;
-use crate::realize::CounterweightParams;
+use crate::realize::{Counterweight, Spring};
 
 /// What went wrong before any set was solved.
 #[derive(Debug, thiserror::Error)]
@@ -98,21 +98,11 @@ pub enum ElementLimits {
     Spring(SpringLimits),
 }
 
-/// A spring of a design.
+/// A spring of a design: its physical parameters and the share of the balancing it does.
 #[derive(Clone, Debug, Serialize)]
 pub struct PartialSpring {
-    pub entry: usize,
-    pub label: String,
-    /// Body of anchor a.
-    pub body: usize,
-    /// Body (or the base) of anchor b.
-    pub other: Attachment,
-    /// N/m.
-    pub stiffness: f64,
-    /// Anchor on `body`, in its frame (m).
-    pub anchor_a: [f64; 3],
-    /// Anchor on `other`, in its frame (m).
-    pub anchor_b: [f64; 3],
+    #[serde(flatten)]
+    pub spring: Spring,
     /// RMS over the workspace of the torque this spring alone exerts, `√(Σ RMS_j²)` over the
     /// selected joints (N·m or N): how much of the balancing it does.
     pub torque_rms: f64,
@@ -125,7 +115,7 @@ pub struct PartialDesign {
     pub entries: Vec<usize>,
     pub labels: Vec<String>,
     /// The design; a counterweight of (numerically) zero mass is listed with offset 0.
-    pub counterweights: Vec<CounterweightParams>,
+    pub counterweights: Vec<Counterweight>,
     /// The design's springs; one of (numerically) zero stiffness is listed with anchors 0.
     pub springs: Vec<PartialSpring>,
     /// Labels of elements the optimum leaves at zero mass (or stiffness): the set is really a
@@ -479,26 +469,22 @@ fn solve_set(ctx: &Context, set: impl Iterator<Item = (usize, usize)>) -> Partia
             }
         }
         match &catalogue.entries[entry].element {
-            Element::Counterweight { body, axes } => {
+            Element::Counterweight { axes, .. } => {
                 let mut offset = [0.0; 3];
                 if used {
                     for (&axis, &col) in axes.iter().zip(&block.moment) {
                         offset[axis] = x[col] / scale;
                     }
                 }
-                params.push(CounterweightParams {
-                    entry,
-                    body: *body,
+                params.push(Counterweight {
+                    label: label.clone(),
+                    body: catalogue.entries[entry].bodies[0].clone(),
                     mass: if used { scale } else { 0.0 },
                     offset,
+                    plane: None,
                 });
             }
-            Element::Spring {
-                body,
-                other,
-                axes_a,
-                axes_b,
-            } => {
+            Element::Spring { axes_a, axes_b, .. } => {
                 let (mut anchor_a, mut anchor_b) = ([0.0; 3], [0.0; 3]);
                 if used && let Some(s) = &block.spring {
                     for (&axis, &col) in axes_a.iter().zip(&block.moment) {
@@ -509,14 +495,17 @@ fn solve_set(ctx: &Context, set: impl Iterator<Item = (usize, usize)>) -> Partia
                     }
                 }
                 let range = block.mass..block.mass + vars;
+                let bodies = &catalogue.entries[entry].bodies;
                 spring_params.push(PartialSpring {
-                    entry,
-                    label: label.clone(),
-                    body: *body,
-                    other: *other,
-                    stiffness: if used { scale } else { 0.0 },
-                    anchor_a,
-                    anchor_b,
+                    spring: Spring {
+                        label: label.clone(),
+                        body: bodies[0].clone(),
+                        other: bodies[1].clone(),
+                        stiffness: if used { scale } else { 0.0 },
+                        anchor_a,
+                        anchor_b,
+                        plane: None,
+                    },
                     torque_rms: torque_alone(
                         basis,
                         &cols[range.clone()],

@@ -45,7 +45,7 @@ use crate::refine::{
     FEASIBILITY_TOL, counterweight_directions, merit, project_fixed, project_radius, refine,
 };
 use crate::relaxation::RelaxationBase;
-use crate::springs::{SpringValues, realize_springs};
+use crate::springs::{Spring, realize_springs};
 use crate::torque::TaskTorques;
 use node::{Coordinate, NodeBox, coordinates};
 
@@ -90,7 +90,7 @@ pub struct Design {
     /// The full lifted point (springs realized).
     pub x: DVector<f64>,
     pub cws: Vec<CwPhysical>,
-    pub springs: Vec<SpringValues>,
+    pub springs: Vec<Spring>,
     /// The objective on the tasks searched, N·m.
     pub value: f64,
 }
@@ -197,7 +197,7 @@ fn verified_design(
     problem: &VariantProblem,
     tasks: &[Arc<TaskTorques>],
     objective: Objective,
-    springs: Vec<SpringValues>,
+    springs: Vec<Spring>,
     x_full: DVector<f64>,
 ) -> Option<Design> {
     let cws = problem.cw_physical(&x_full);

@@ -4,7 +4,6 @@
 use counterpoise_dynamics::linalg::checked_svd;
 use std::collections::BTreeSet;
 
-use counterpoise_balance::Attachment;
 use counterpoise_dynamics::Indicators;
 use counterpoise_dynamics::params::Variant;
 use nalgebra::{DMatrix, DVector};
@@ -16,8 +15,8 @@ use super::state::*;
 use crate::context::Context;
 use crate::problem::VariantProblem;
 use crate::progress::{ProgressSink, ShareCounter, StageCounter};
-use crate::result::{Counterweight, FreeParameter, OptimisedVariant, Spring, Status};
-use crate::springs::{SpringValues, realize_springs_reusing};
+use crate::result::{FreeParameter, OptimisedVariant, Status};
+use crate::springs::{Spring, realize_springs_reusing};
 use crate::timing::{StageTime, Stopwatch};
 use crate::verify::verify;
 
@@ -108,7 +107,7 @@ pub(super) fn free_parameters(
 }
 
 /// The chosen springs, the lifted point with them, and their ΔR on the reaction tasks.
-pub(super) type SpringChoice = (Vec<SpringValues>, DVector<f64>, Option<f64>);
+pub(super) type SpringChoice = (Vec<Spring>, DVector<f64>, Option<f64>);
 
 /// Spring choice by ΔR, final all-task evaluation, verification and the output records.
 pub(super) fn finish(
@@ -369,42 +368,10 @@ pub(super) fn record(
         out.reason = Some("no candidate parameters were produced".into());
         return out;
     };
-    let name = |b: usize| ctx.model.bodies[b].name.clone();
-    let balancing = ctx.model.balancing.as_ref();
-    let cw_plane = balancing
-        .and_then(|b| b.counterweights.as_ref())
-        .and_then(|c| c.plane);
-    let spring_plane = balancing
-        .and_then(|b| b.springs.as_ref())
-        .and_then(|s| s.plane);
-    out.counterweights = problem
-        .counterweights
-        .iter()
-        .zip(&cand.cws)
-        .map(|(slot, p)| Counterweight {
-            label: slot.label.clone(),
-            body: name(slot.body),
-            mass: p.mass,
-            offset: p.offset(),
-            plane: cw_plane,
-        })
-        .collect();
-    out.springs = cand
-        .springs
-        .iter()
-        .map(|s| Spring {
-            label: s.label.clone(),
-            body: name(s.body),
-            other: match s.other {
-                Attachment::Base => "base".into(),
-                Attachment::Body(b) => name(b),
-            },
-            stiffness: s.stiffness,
-            anchor_a: s.anchor_a,
-            anchor_b: s.anchor_b,
-            plane: spring_plane,
-        })
-        .collect();
+    // The elements as the results record them and the balance check samples them.
+    let elements = dynamics_variant(&ctx.model, problem, &cand.cws, &cand.springs);
+    out.counterweights = elements.counterweights.clone();
+    out.springs = elements.springs.clone();
     out.free_parameters = free_parameters(problem, &lifted_names(ctx, problem), &cand.x);
     out.lower_bound = cand.bound_certified.then_some(cand.lower_bound);
     let ind = match indicators {
@@ -425,7 +392,14 @@ pub(super) fn record(
     out.gap = out
         .lower_bound
         .map(|lb| ((objective - lb) / objective.abs().max(1e-300)).max(0.0));
-    let report = verify(problem, &ctx.checks, &cand.cws, &cand.springs, &ind);
+    let report = verify(
+        problem,
+        &ctx.checks,
+        &elements,
+        &cand.cws,
+        &cand.springs,
+        &ind,
+    );
     out.residual = Some(report.balance_residual);
     let passed = report.passed;
     if !passed {

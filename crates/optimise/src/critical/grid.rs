@@ -1,7 +1,6 @@
 //! The all-task evaluations of the loop: candidates as the dynamics crate's variants, their
 //! indicators over the task grid in batches, and each variant's new critical tasks.
 
-use counterpoise_balance::Attachment;
 use counterpoise_dynamics::params::{Counterweight, ParameterSet, Spring, Variant};
 use counterpoise_dynamics::{
     Combination, EvaluateOptions, GridProgress, Indicators, evaluate_grid_indicators_reporting,
@@ -12,7 +11,6 @@ use super::state::*;
 use crate::context::Context;
 use crate::problem::{CwPhysical, Objective, VariantProblem};
 use crate::progress::ShareCounter;
-use crate::springs::SpringValues;
 
 /// The dynamics variants of the current candidates of runs `ks` (each has a problem and a
 /// candidate).
@@ -37,7 +35,7 @@ pub(super) fn dynamics_variant(
     model: &Model,
     problem: &VariantProblem,
     cws: &[CwPhysical],
-    springs: &[SpringValues],
+    springs: &[Spring],
 ) -> Variant {
     let name = |b: usize| model.bodies[b].name.clone();
     let balancing = model.balancing.as_ref();
@@ -63,16 +61,8 @@ pub(super) fn dynamics_variant(
         springs: springs
             .iter()
             .map(|s| Spring {
-                label: s.label.clone(),
-                body: name(s.body),
-                other: match s.other {
-                    Attachment::Base => counterpoise_vocabulary::BASE.into(),
-                    Attachment::Body(b) => name(b),
-                },
-                stiffness: s.stiffness,
-                anchor_a: s.anchor_a,
-                anchor_b: s.anchor_b,
                 plane: spring_plane,
+                ..s.clone()
             })
             .collect(),
     }

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::certify::SearchState;
 use crate::problem::{CwPhysical, Objective, VariantProblem};
 use crate::result::Iteration;
-use crate::springs::{SpringValues, StartRecord};
+use crate::springs::{Spring, StartRecord};
 use crate::timing::StageTime;
 
 /// Settings of the optimisation.
@@ -103,7 +103,7 @@ impl Failure {
 pub(super) struct Candidate {
     pub(super) x: DVector<f64>,
     pub(super) cws: Vec<CwPhysical>,
-    pub(super) springs: Vec<SpringValues>,
+    pub(super) springs: Vec<Spring>,
     /// 0 (the trivial bound) when the relaxation was not solved.
     pub(super) lower_bound: f64,
     /// Whether `lower_bound` is the relaxation's certified bound.

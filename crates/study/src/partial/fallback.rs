@@ -440,15 +440,9 @@ fn section(
             elements: d
                 .counterweights
                 .iter()
-                .map(|cw| {
-                    let label = super::model_label(d, cw.entry);
-                    PartialElement {
-                        unused: d.unused.contains(&label),
-                        label,
-                        body: model.bodies[cw.body].name.clone(),
-                        mass: cw.mass,
-                        offset: cw.offset,
-                    }
+                .map(|cw| PartialElement {
+                    unused: d.unused.contains(&cw.label),
+                    counterweight: cw.clone(),
                 })
                 .collect(),
             total_rms: d.total_rms,
@@ -497,7 +491,7 @@ fn best_lines(model: &Model, c: &Computed) -> (String, Vec<String>) {
                 } else {
                     per_joint.join(", ")
                 },
-                design_line(model, d)
+                design_line(d)
             )
         })
         .collect();
@@ -530,7 +524,7 @@ pub fn csv(model: &Model, c: &Computed) -> String {
         for v in &d.rms {
             let _ = write!(out, ",{v}");
         }
-        let _ = writeln!(out, ",{}", quote(&design_line(model, d)));
+        let _ = writeln!(out, ",{}", quote(&design_line(d)));
     }
     out
 }

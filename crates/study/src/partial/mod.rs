@@ -16,8 +16,7 @@ use counterpoise_balance::partial::{
 };
 use counterpoise_balance::search::decide;
 use counterpoise_balance::{
-    Attachment, Catalogue, Status, VerificationSet, catalogue_options, mechanism_energy,
-    realization_hints,
+    Catalogue, Status, VerificationSet, catalogue_options, mechanism_energy, realization_hints,
 };
 use counterpoise_dynamics::Evaluator;
 use counterpoise_model::limits::{Limit, format_count};
@@ -395,13 +394,6 @@ fn millimetres(metres: f64) -> f64 {
 }
 
 /// The name of a spring's second body, or `base`.
-fn attachment_name(model: &Model, other: Attachment) -> &str {
-    match other {
-        Attachment::Base => "base",
-        Attachment::Body(s) => &model.bodies[s].name,
-    }
-}
-
 /// `(x, y, z)` in mm, rounded to 0.1 mm.
 fn point_mm(p: &[f64; 3]) -> String {
     format!(
@@ -412,8 +404,9 @@ fn point_mm(p: &[f64; 3]) -> String {
     )
 }
 
-fn design_line(model: &Model, d: &PartialDesign) -> String {
-    let springs = d.springs.iter().map(|s| {
+fn design_line(d: &PartialDesign) -> String {
+    let springs = d.springs.iter().map(|p| {
+        let s = &p.spring;
         if d.unused.contains(&s.label) {
             format!("{}: unused (0 N/m)", s.label)
         } else {
@@ -422,17 +415,17 @@ fn design_line(model: &Model, d: &PartialDesign) -> String {
                 s.label,
                 s.stiffness,
                 point_mm(&s.anchor_a),
-                model.bodies[s.body].name,
+                s.body,
                 point_mm(&s.anchor_b),
-                attachment_name(model, s.other),
-                s.torque_rms
+                s.other,
+                p.torque_rms
             )
         }
     });
     d.counterweights
         .iter()
         .map(|c| {
-            let label = &model_label(d, c.entry);
+            let label = &c.label;
             if d.unused.contains(label) {
                 format!("{label}: unused (0 kg)")
             } else {
@@ -444,7 +437,7 @@ fn design_line(model: &Model, d: &PartialDesign) -> String {
                     millimetres(c.offset[1]),
                     millimetres(c.offset[2]),
                     r * 1e3,
-                    model.bodies[c.body].name
+                    c.body
                 )
             }
         })
@@ -473,13 +466,6 @@ fn bound_line(d: &PartialDesign, unbalanced: f64) -> String {
             100.0 * d.gap / unbalanced.max(f64::MIN_POSITIVE)
         )
     }
-}
-
-fn model_label(d: &PartialDesign, entry: usize) -> String {
-    d.entries
-        .iter()
-        .position(|&e| e == entry)
-        .map_or_else(|| "?".into(), |i| d.labels[i].clone())
 }
 
 fn tables(model: &Model, computed: &Computed) -> String {
@@ -553,7 +539,7 @@ fn tables(model: &Model, computed: &Computed) -> String {
             out.push_str(&format!(" {:>12.2}", change(*v, report.unbalanced_rms[j])));
         }
         out.push('\n');
-        out.push_str(&format!("      {}\n", design_line(model, d)));
+        out.push_str(&format!("      {}\n", design_line(d)));
         if d.status != "Solved" {
             out.push_str(&format!("      solver status: {}\n", d.status));
         }
@@ -588,19 +574,7 @@ pub fn to_json(model: &Model, computed: &Computed) -> serde_json::Value {
         seconds,
     } = computed;
     let names: Vec<&str> = model.actuators.iter().map(|a| a.name.as_str()).collect();
-    // Each spring with the names of the bodies its anchors are on.
-    let mut designs = serde_json::to_value(&report.designs).unwrap_or_default();
-    if let Some(list) = designs.as_array_mut() {
-        for (d, design) in list.iter_mut().zip(&report.designs) {
-            let Some(springs) = d.get_mut("springs").and_then(|s| s.as_array_mut()) else {
-                continue;
-            };
-            for (s, spring) in springs.iter_mut().zip(&design.springs) {
-                s["body_name"] = json!(model.bodies[spring.body].name);
-                s["other_name"] = json!(attachment_name(model, spring.other));
-            }
-        }
-    }
+    let designs = serde_json::to_value(&report.designs).unwrap_or_default();
     let exact: Vec<serde_json::Value> = shown
         .iter()
         .zip(verdicts)
