@@ -48,7 +48,7 @@ fn variants_json_lists_every_variant_with_elements_and_status() {
     let out = counterpoise(&["variants", "cases/palletizer.json", "--dmax", "1", "--json"]);
     assert!(out.status.success(), "{}", stderr(&out));
     let doc: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
-    assert_eq!(doc["schema_version"], 1);
+    assert_eq!(doc["schema_version"], 2);
     let variants = doc["variants"].as_array().unwrap();
     assert_eq!(variants.len(), 28, "7 counterweights + 21 springs");
     let m4 = variants
@@ -59,6 +59,11 @@ fn variants_json_lists_every_variant_with_elements_and_status() {
     assert_eq!(m4["elements"][0]["type"], "counterweight");
     assert_eq!(m4["elements"][0]["bodies"][0], "upper_arm");
     assert!(m4["verification"]["residual"].as_f64().unwrap() < 1e-9);
+    // The witness names its element and body as the element list does (schema 2).
+    let witness = &m4["witness"]["counterweights"][0];
+    assert_eq!(witness["label"], "m4");
+    assert_eq!(witness["body"], "upper_arm");
+
     let total: u64 = doc["counts"]
         .as_object()
         .unwrap()
@@ -66,6 +71,30 @@ fn variants_json_lists_every_variant_with_elements_and_status() {
         .map(|v| v.as_u64().unwrap())
         .sum();
     assert_eq!(total, 28);
+}
+
+/// The witness of `m2 + K10` on the two-link arm names its elements and bodies, and its
+/// counterweight carries link 2 alone: `m2·r2 = −(m_link2·c2 + m_tool·L2) = −(2.5·0.3 + 1·0.6)
+/// = −1.35 kg·m` along the link (cases/two_link.json), whatever the spring does on link 1.
+#[test]
+fn a_witness_names_its_elements_and_bodies() {
+    let out = counterpoise(&["variants", "cases/two_link.json", "--dmax", "2", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let doc: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let v = doc["variants"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|v| v["elements"][0]["label"] == "m2" && v["elements"][1]["label"] == "K10")
+        .expect("m2 + K10");
+    assert_eq!(v["status"], "balanced");
+    let cw = &v["witness"]["counterweights"][0];
+    assert_eq!((&cw["label"], &cw["body"]), (&"m2".into(), &"link2".into()));
+    let moment = cw["mass"].as_f64().unwrap() * cw["offset"][0].as_f64().unwrap();
+    assert!((moment + 1.35).abs() < 1e-9, "{moment}");
+    let spring = &v["witness"]["springs"][0];
+    assert_eq!(spring["label"], "K10");
+    assert_eq!((&spring["body"], &spring["other"]), (&"link1".into(), &"base".into()));
 }
 
 #[test]

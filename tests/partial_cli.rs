@@ -56,8 +56,8 @@ fn pendulum_matches_the_closed_form() {
     assert_eq!(spring["certified"], true, "{spring}");
     assert!(f(&spring["gap"]) < 1e-3 * G * mean_cos, "{spring}");
     let k = &spring["springs"][0];
-    assert_eq!(k["body_name"], "rod");
-    assert_eq!(k["other_name"], "base");
+    assert_eq!(k["body"], "rod");
+    assert_eq!(k["other"], "base");
     assert!(close(f(&k["stiffness"]), 100.0, 1e-5), "{k}");
     assert!(close(f(&k["torque_rms"]), 5.0 * mean_cos, 1e-5), "{k}");
     assert_eq!(both["designs"][1]["labels"], json!(["m1"]));

@@ -17,7 +17,9 @@ use crate::guards::located;
 use crate::preflight;
 
 /// Version of the `variants --json` schema (documented in README.md).
-pub const SCHEMA_VERSION: u32 = 1;
+/// 2: elements are named by catalogue label and body names (1 gave catalogue and body
+/// indices).
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// `counterpoise variants`: every set of at most Dmax elements decided (or, with `minimal`,
 /// the minimal balancing sets), as tables or as the JSON document.

@@ -28,7 +28,9 @@ use crate::error::{Result, StudyError, invalid};
 use crate::guards::located;
 
 /// Version of the `partial --json` document (documented in README.md).
-pub const SCHEMA_VERSION: u32 = 1;
+/// 2: elements are named by catalogue label and body names (1 gave catalogue and body
+/// indices).
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// Values per varying actuator of the workspace sample when `--points` is not given (fewer
 /// when their product would exceed the grid-points limit): 7 values see every harmonic of an
