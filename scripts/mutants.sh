@@ -49,9 +49,10 @@ if [[ ${#files[@]} -eq 0 ]]; then
         crates/balance/src/verify.rs
         crates/balance/src/enumerate.rs
         crates/dynamics/src/indicators.rs
-        crates/report/src/indicators.rs
+        crates/vocabulary/src/indicators.rs
         crates/report/src/ranking.rs
-        crates/optimise/src/critical.rs
+        crates/optimise/src/critical/peaks.rs
+        crates/optimise/src/critical/finish.rs
     )
 fi
 args=()

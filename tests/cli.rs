@@ -94,7 +94,10 @@ fn a_witness_names_its_elements_and_bodies() {
     assert!((moment + 1.35).abs() < 1e-9, "{moment}");
     let spring = &v["witness"]["springs"][0];
     assert_eq!(spring["label"], "K10");
-    assert_eq!((&spring["body"], &spring["other"]), (&"link1".into(), &"base".into()));
+    assert_eq!(
+        (&spring["body"], &spring["other"]),
+        (&"link1".into(), &"base".into())
+    );
 }
 
 #[test]
