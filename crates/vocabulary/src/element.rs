@@ -132,6 +132,13 @@ mod tests {
         }
     }
 
+    /// The reports' headings are the paper's words for its three classes (Sec. 3).
+    #[test]
+    fn class_titles_are_the_papers() {
+        let titles = Class::ALL.map(Class::title);
+        assert_eq!(titles, ["Counterweights only", "Springs only", "Hybrid"]);
+    }
+
     #[test]
     fn a_variants_class_is_what_its_elements_are() {
         use ElementKind::*;

@@ -116,6 +116,18 @@ mod tests {
         names.sort();
         names.dedup();
         assert_eq!(names.len(), all.len());
+        // Each meaning is its own line of the counts table and says what the status is.
+        let mut meanings: Vec<_> = all.iter().map(|s| s.meaning()).collect();
+        meanings.sort();
+        meanings.dedup();
+        assert_eq!(meanings.len(), all.len());
+        assert!(Status::Feasible.meaning().contains("ranked"));
+        assert!(
+            Status::Infeasible
+                .meaning()
+                .contains("no parameters balance")
+        );
+        assert!(Status::Balanced.meaning().contains("not yet optimised"));
         // Only the optimiser turns a balanced variant into a ranked one.
         assert!(!Status::STUDY_VERDICTS.contains(&Status::Balanced));
         assert!(!Status::SEARCH_VERDICTS.contains(&Status::Feasible));
