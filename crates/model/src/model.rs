@@ -500,6 +500,23 @@ impl Model {
         Point::new(q, &self.kinds())
     }
 
+    /// The plane the case restricts counterweight offsets to, if any (the reports give the
+    /// offsets in polar form in it).
+    pub fn counterweight_plane(&self) -> Option<Plane> {
+        self.balancing
+            .as_ref()
+            .and_then(|b| b.counterweights.as_ref())
+            .and_then(|c| c.plane)
+    }
+
+    /// The plane the case restricts spring anchors to, if any.
+    pub fn spring_plane(&self) -> Option<Plane> {
+        self.balancing
+            .as_ref()
+            .and_then(|b| b.springs.as_ref())
+            .and_then(|s| s.plane)
+    }
+
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.bodies.iter().position(|b| b.name == name)
     }

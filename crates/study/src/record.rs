@@ -138,13 +138,7 @@ pub(crate) fn record(
         boxes: Some(opt.boxes),
         message: opt.reason.clone(),
     });
-    let balancing = model.balancing.as_ref();
-    let cw_plane = balancing
-        .and_then(|b| b.counterweights.as_ref())
-        .and_then(|c| c.plane);
-    let spring_plane = balancing
-        .and_then(|b| b.springs.as_ref())
-        .and_then(|s| s.plane);
+    let (cw_plane, spring_plane) = (model.counterweight_plane(), model.spring_plane());
     // The planes are the case's (a shard file written before planes were recorded in it
     // still gives the report its polar form).
     r.parameters = Some(PhysicalParameters {

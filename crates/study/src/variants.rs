@@ -131,13 +131,7 @@ pub fn witness_lines(model: &Model, v: &VariantResult) -> Vec<String> {
         return Vec::new();
     };
     let mut lines = Vec::new();
-    let balancing = model.balancing.as_ref();
-    let cw_plane = balancing
-        .and_then(|b| b.counterweights.as_ref())
-        .and_then(|c| c.plane);
-    let spring_plane = balancing
-        .and_then(|b| b.springs.as_ref())
-        .and_then(|c| c.plane);
+    let (cw_plane, spring_plane) = (model.counterweight_plane(), model.spring_plane());
     for cw in &w.counterweights {
         let (r, phi) = polar(cw.offset, cw_plane);
         lines.push(format!(

@@ -38,13 +38,7 @@ pub(super) fn dynamics_variant(
     springs: &[Spring],
 ) -> Variant {
     let name = |b: usize| model.bodies[b].name.clone();
-    let balancing = model.balancing.as_ref();
-    let cw_plane = balancing
-        .and_then(|b| b.counterweights.as_ref())
-        .and_then(|c| c.plane);
-    let spring_plane = balancing
-        .and_then(|b| b.springs.as_ref())
-        .and_then(|s| s.plane);
+    let (cw_plane, spring_plane) = (model.counterweight_plane(), model.spring_plane());
     Variant {
         counterweights: problem
             .counterweights
