@@ -318,19 +318,38 @@ impl RelaxationBase {
         column: usize,
         max_iter: u32,
     ) -> Option<[f64; 2]> {
+        self.combination_range(problem, node, &[(column, 1.0)], max_iter)
+    }
+
+    /// [`RelaxationBase::lifted_range`] of a linear combination `Σ c·x_column` of lifted
+    /// variables, given as `(column, c)` terms.
+    pub fn combination_range(
+        &self,
+        problem: &VariantProblem,
+        node: Option<&NodeBox>,
+        terms: &[(usize, f64)],
+        max_iter: u32,
+    ) -> Option<[f64; 2]> {
         let mut out = [0.0; 2];
+        let natural = terms
+            .iter()
+            .map(|&(j, c)| c.abs() * self.0.natural[j])
+            .fold(0.0f64, f64::max)
+            .max(1e-300);
         for (side, sign) in [(0, 1.0), (1, -1.0)] {
             let mut built = self.0.clone();
             if let Some(node) = node {
                 add_node_rows(problem, &mut built, node);
             }
-            let natural = built.natural[column];
             built.cp.objective.iter_mut().for_each(|c| *c = 0.0);
-            for k in 0..problem.dim() {
-                built.cp.objective[built.z[k]] =
-                    sign * problem.nullspace[(column, k)] * built.dz[k] / natural;
+            let mut constant = 0.0;
+            for &(column, c) in terms {
+                for k in 0..problem.dim() {
+                    built.cp.objective[built.z[k]] +=
+                        sign * c * problem.nullspace[(column, k)] * built.dz[k] / natural;
+                }
+                constant += sign * c * problem.particular[column] / natural;
             }
-            let constant = sign * problem.particular[column] / natural;
             let solution = built.cp.solve(max_iter);
             if solution.status.is_infeasible() {
                 return Some([f64::INFINITY, f64::NEG_INFINITY]);
@@ -344,6 +363,140 @@ impl RelaxationBase {
         }
         Some(out)
     }
+
+    /// The intervals of each spring's Lagrange vector (see [`lagrange_terms`]) over this
+    /// relaxation restricted to `node`, for the springs with a lower anchor norm bound (an
+    /// empty list for the others, and for any whose range is unknown).
+    pub fn lagrange_ranges(
+        &self,
+        problem: &VariantProblem,
+        node: Option<&NodeBox>,
+        max_iter: u32,
+    ) -> Vec<Vec<[f64; 2]>> {
+        problem
+            .springs
+            .iter()
+            .map(|s| {
+                if s.bounds.anchor_a[0] <= 0.0 && s.bounds.anchor_b[0] <= 0.0 {
+                    return Vec::new();
+                }
+                lagrange_terms(s)
+                    .iter()
+                    .map(|terms| self.combination_range(problem, node, terms, max_iter))
+                    .collect::<Option<Vec<_>>>()
+                    .filter(|r| r.iter().all(|[lo, hi]| lo <= hi))
+                    .unwrap_or_default()
+            })
+            .collect()
+    }
+
+    /// This relaxation with each spring's anchor lengths bounded through its Lagrange vector:
+    /// `v = (K a·b, K a×b)` has `|v| = K|a||b|` (Lagrange's identity `(a·b)² + |a×b|² =
+    /// |a|²|b|²`), so the lower norm bound `|a| ≥ a_lo` gives `a_lo·|K b| ≤ |v|`, and
+    /// `|v| ≤ Σ_i |v_i|`, each `|v_i|` below its chord over the interval `ranges` gives it
+    /// (likewise `b_lo·|K a| ≤ |v|`). Every physical point whose Lagrange vector lies in those
+    /// intervals meets these cones. Where balance fixes `v` (a spring that must carry a given
+    /// moment) they bound `K b` exactly as the non-convex `|a| ≥ a_lo` does, which the
+    /// relaxation otherwise drops and the search recovers only by splitting `a` around its
+    /// excluded disc.
+    pub fn with_lagrange_bounds(
+        mut self,
+        problem: &VariantProblem,
+        ranges: &[Vec<[f64; 2]>],
+    ) -> Self {
+        let built = &mut self.0;
+        for (s, ranges) in problem.springs.iter().zip(ranges) {
+            let terms = lagrange_terms(s);
+            if ranges.len() != terms.len() || terms.is_empty() {
+                continue;
+            }
+            let (na, nb) = (s.axes_a.len(), s.axes_b.len());
+            let big_k = built.natural[s.column];
+            let a_nat = built.natural[s.column + 1] / big_k;
+            let b_nat = built.natural[s.column + 1 + na] / big_k;
+            let unit = big_k * a_nat * b_nat;
+            // Σ_i chord_i(v_i), normalised by K̄·ā·b̄.
+            let mut head = Affine::constant(0.0);
+            for (component, &[lo, hi]) in terms.iter().zip(ranges) {
+                let mut v = Affine::constant(0.0);
+                for &(j, c) in component {
+                    v.add_scaled(&built.xn(problem, j), c * built.natural[j] / unit);
+                }
+                let (lo, hi) = (lo / unit, hi / unit);
+                if lo >= 0.0 {
+                    head.add_scaled(&v, 1.0);
+                } else if hi <= 0.0 {
+                    head.add_scaled(&v, -1.0);
+                } else {
+                    let slope = (hi.abs() - lo.abs()) / (hi - lo);
+                    head.constant += lo.abs() - slope * lo;
+                    head.add_scaled(&v, slope);
+                }
+            }
+            // The head is at least Σ min(|lo_i|, |hi_i|) over the intervals (each term is
+            // linear between |lo_i| and |hi_i|).
+            let least: f64 = ranges.iter().map(|&[lo, hi]| lo.abs().min(hi.abs())).sum();
+            let k_hi = s.bounds.stiffness[1];
+            for (floor, nat, first, n, reach) in [
+                (
+                    s.bounds.anchor_a[0],
+                    a_nat,
+                    s.column + 1 + na,
+                    nb,
+                    s.bounds.anchor_b[1],
+                ),
+                (
+                    s.bounds.anchor_b[0],
+                    b_nat,
+                    s.column + 1,
+                    na,
+                    s.bounds.anchor_a[1],
+                ),
+            ] {
+                // A cone that cannot cut (its cap above what `|K b| ≤ b_hi·K_hi` allows) is
+                // left out: it changes no bound, and clarabel stalls on such far-inactive cones.
+                if floor <= 0.0 || n == 0 || least >= floor * reach * k_hi {
+                    continue;
+                }
+                // floor·|K b| / (K̄ ā b̄) = (floor/ā)·|K b|/(K̄ b̄) for the a floor (and b's).
+                let tail: Vec<Affine> = (0..n)
+                    .map(|i| built.xn(problem, first + i).scaled(floor / nat))
+                    .collect();
+                built.cp.soc(&head, &tail);
+            }
+        }
+        self
+    }
+}
+
+/// A spring's Lagrange vector `v = (K a·b, K (a×b)_x, K (a×b)_y, K (a×b)_z)` as linear
+/// combinations `(lifted column, coefficient)` of its coupling entries `W_kl = K a_k b_l`
+/// (over the body-frame axes the anchors have; components that are identically zero are left
+/// out). `|v| = K|a||b|` at every physical point.
+pub fn lagrange_terms(s: &crate::slots::SpringSlot) -> Vec<Vec<(usize, f64)>> {
+    let (na, nb) = (s.axes_a.len(), s.axes_b.len());
+    let column = |k: usize, l: usize| -> Option<usize> {
+        let i = s.axes_a.iter().position(|&a| a == k)?;
+        let j = s.axes_b.iter().position(|&b| b == l)?;
+        Some(s.column + 1 + na + nb + i * nb + j)
+    };
+    let mut out = Vec::new();
+    let dot: Vec<(usize, f64)> = (0..3)
+        .filter_map(|d| column(d, d).map(|j| (j, 1.0)))
+        .collect();
+    if !dot.is_empty() {
+        out.push(dot);
+    }
+    for (k, l) in [(1, 2), (2, 0), (0, 1)] {
+        let cross: Vec<(usize, f64)> = [(k, l, 1.0), (l, k, -1.0)]
+            .into_iter()
+            .filter_map(|(p, q, c)| column(p, q).map(|j| (j, c)))
+            .collect();
+        if !cross.is_empty() {
+            out.push(cross);
+        }
+    }
+    out
 }
 
 /// Appends a node's rows (see [`solve_relaxation_in`]).

@@ -483,3 +483,122 @@ fn a_hybrid_whose_boxes_propose_poor_designs_is_descended_to_a_better_one() {
     assert!(v.residual.unwrap() <= 1e-9);
     assert!(v.verification.as_ref().unwrap().passed);
 }
+
+/// `m4 + K32 + K73` balances only with `K73·ay = 0` and `K32 + 20·K73·ax = 0` (the relations
+/// the balance search prints), so every physical spring has K73's anchor on its body's x axis
+/// at `ax = −K32/(20·K73)`: with both stiffnesses in `[1000, 10000]` N/m, `ax ∈ [−0.5, −0.005]`
+/// m. The case's bounds alone give `[−1, 1]` m (the anchor's reach) for both components; the
+/// search's first box must be narrowed to `ay = 0` (up to the relaxation's margin) and into
+/// that interval (and still hold the design the run finds).
+#[test]
+fn the_first_box_holds_an_anchor_component_balance_fixes_at_its_value() {
+    use counterpoise_optimise::certify::{BranchOptions, DEFAULT_MAX_NODES, node, root_box};
+    let mut json = common::case_json("palletizer.json");
+    json["balancing"]["dmax"] = serde_json::json!(3);
+    let model = common::model(&json);
+    let (ctx, results) = common::optimise(
+        &model,
+        &[&["m4", "K32", "K73"]],
+        &OptimiseOptions::default(),
+    );
+    let problem = variant_problem(&ctx, &["m4", "K32", "K73"]);
+    let k73 = problem
+        .springs
+        .iter()
+        .position(|s| s.label == "K73")
+        .unwrap();
+    assert_eq!(problem.springs[k73].axes_a, vec![0, 1]);
+    let wide = node::NodeBox::root(&problem).unwrap();
+    assert_eq!(wide.anchor(&problem, k73, false, 0), [-1.0, 1.0]);
+    assert_eq!(wide.anchor(&problem, k73, false, 1), [-1.0, 1.0]);
+    let options = BranchOptions {
+        gap_tolerance: 1e-3,
+        max_nodes: DEFAULT_MAX_NODES,
+        solver_iterations: 200,
+    };
+    let root = root_box(&problem, &options).unwrap();
+    // ay's range is 0 widened by the relaxation's relative margin (1e-6 of the reach).
+    let [ylo, yhi] = root.anchor(&problem, k73, false, 1);
+    assert!(
+        ylo <= 0.0 && 0.0 <= yhi && yhi - ylo <= 4e-6,
+        "ay ∈ [{ylo}, {yhi}]"
+    );
+    let [lo, hi] = root.anchor(&problem, k73, false, 0);
+    // The hand interval, to the relaxation's margin (its ranges are widened by 1e-6 relative).
+    assert!(
+        (lo + 0.5).abs() < 1e-5 && (hi + 0.005).abs() < 1e-6,
+        "ax ∈ [{lo}, {hi}]"
+    );
+    let v = &results[0];
+    assert!(v.is_feasible(), "{:?}", v.reason);
+    let spring = v.springs.iter().find(|s| s.label == "K73").unwrap();
+    let ax = spring.anchor_a[0];
+    assert!(
+        lo <= ax && ax <= hi,
+        "the design's ax = {ax} outside [{lo}, {hi}]"
+    );
+    let k32 = v.springs.iter().find(|s| s.label == "K32").unwrap();
+    assert!((k32.stiffness + 20.0 * spring.stiffness * ax).abs() < 1e-6 * k32.stiffness);
+}
+
+/// `m5 + K63 + K65` balances only with `K63·(ax·bx + ay·by) = 0` and
+/// `K63·(ax·by − ay·bx) = 5382747/8000` N·m (the relations the balance search prints): K63
+/// must carry a fixed moment, so its Lagrange vector `(K a·b, K (a×b)_z)` is the point
+/// `(0, 672.843…)`, and with `|a| ≥ 0.25` m (the case's lower anchor bound) `K·|b| ≤
+/// 672.843/0.25 = 2691.37` N — which caps the counterweight's moment through
+/// `m5·r5x = −9233/32 + (25/981)·K63·by`. The relaxation without that cap stopped at a 2.3 %
+/// gap after 800 boxes; with it the search closes the gap.
+#[test]
+fn a_spring_that_carries_a_fixed_moment_bounds_its_anchor_through_the_lower_norm_bound() {
+    use counterpoise_optimise::certify::{BranchOptions, DEFAULT_MAX_NODES, root_box};
+    use counterpoise_optimise::relaxation::{RelaxationBase, lagrange_terms};
+    let mut json = common::case_json("palletizer.json");
+    json["balancing"]["dmax"] = serde_json::json!(3);
+    let model = common::model(&json);
+    let (ctx, results) = common::optimise(
+        &model,
+        &[&["m5", "K63", "K65"]],
+        &OptimiseOptions::default(),
+    );
+    let problem = variant_problem(&ctx, &["m5", "K63", "K65"]);
+    let k63 = problem
+        .springs
+        .iter()
+        .position(|s| s.label == "K63")
+        .unwrap();
+    assert_eq!(lagrange_terms(&problem.springs[k63]).len(), 2);
+    let options = BranchOptions {
+        gap_tolerance: 1e-3,
+        max_nodes: DEFAULT_MAX_NODES,
+        solver_iterations: 200,
+    };
+    let root = root_box(&problem, &options).unwrap();
+    let ranges = RelaxationBase::new(&problem, &[], counterpoise_optimise::Objective::Minimax)
+        .lagrange_ranges(&problem, Some(&root), 200);
+    let moment = 5382747.0 / 8000.0;
+    let [dot, cross] = [ranges[k63][0], ranges[k63][1]];
+    // Each range is the point widened by the relaxation's margin, about 1e-6 of the natural
+    // size K_max·|a|_max·|b|_max = 5000 N·m on each side.
+    assert!(
+        dot[0] <= 0.0 && 0.0 <= dot[1] && dot[1] - dot[0] < 2e-2,
+        "K a·b ∈ {dot:?}"
+    );
+    assert!(
+        cross[0] <= moment && moment <= cross[1] && cross[1] - cross[0] < 2e-2,
+        "K (a×b)_z ∈ {cross:?}"
+    );
+    let v = &results[0];
+    assert!(v.is_feasible(), "{:?}", v.reason);
+    let (objective, lower) = (v.objective.unwrap(), v.lower_bound.unwrap());
+    let gap = (objective - lower) / objective;
+    assert!(gap <= 1e-3, "gap {gap:e}");
+    let s = v.springs.iter().find(|s| s.label == "K63").unwrap();
+    let (a, b) = (s.anchor_a, s.anchor_b);
+    let cross_z = s.stiffness * (a[0] * b[1] - a[1] * b[0]);
+    assert!(
+        (cross_z - moment).abs() < 1e-6 * moment,
+        "K (a×b)_z = {cross_z}"
+    );
+    let b_norm = (b[0] * b[0] + b[1] * b[1]).sqrt();
+    assert!(s.stiffness * b_norm <= moment / 0.25 * (1.0 + 1e-6));
+}

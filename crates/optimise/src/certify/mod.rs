@@ -137,6 +137,9 @@ struct Open {
 pub struct SearchState {
     root: NodeBox,
     leaves: Vec<(NodeBox, f64)>,
+    /// Per spring, the intervals of its Lagrange vector over the root box
+    /// ([`RelaxationBase::lagrange_ranges`]; they hold for every task set).
+    lagrange: Vec<Vec<[f64; 2]>>,
 }
 
 impl SearchState {
@@ -360,25 +363,36 @@ fn branching_coordinate(
     }
 }
 
-/// The root box with each counterweight's mass and first-moment intervals narrowed to their
-/// range over the bounds-only relaxation (both are lifted variables, linear in the family):
-/// a mass that balance fixes becomes a point, and the corner planes of `μμᵀ/m` start tight.
-/// Every physical point of the box stays inside (the ranges hold the relaxation's points).
+/// The root box narrowed to what the bounds-only relaxation allows (its ranges hold every
+/// physical point, so the box keeps every design):
+///
+/// - each counterweight's mass and first-moment intervals to their lifted range (both are
+///   lifted variables, linear in the family): a mass that balance fixes becomes a point, and
+///   the corner planes of `μμᵀ/m` start tight;
+/// - each anchor component `a_i = (K a_i)/K` to the quotient of its lifted range by the
+///   stiffness's (`K > 0`): a component that balance holds at zero (`K·a_y = 0`) becomes the
+///   point 0, and one whose lifted value keeps a sign keeps it. Left wide, such a component
+///   spoils the anchors' lower norm bound: the secant of `a_y²` over `[−r, r]` is `r²` at
+///   `a_y = 0`, so `|a| ≥ a_min` never cuts until the search has split the pinned coordinate.
 fn tighten(problem: &VariantProblem, mut root: NodeBox, options: &BranchOptions) -> NodeBox {
     let coords = coordinates(problem);
-    if problem.counterweights.is_empty() {
-        return root;
-    }
     let base = RelaxationBase::new(problem, &[], Objective::Minimax);
+    let range = |root: &NodeBox, column: usize| {
+        base.lifted_range(problem, Some(root), column, options.solver_iterations)
+    };
     for (k, c) in coords.iter().enumerate() {
-        let column = match *c {
-            Coordinate::Mass { cw } => problem.counterweights[cw].column,
-            Coordinate::Moment { cw, k } => problem.counterweights[cw].column + 1 + k,
-            _ => continue,
+        let narrowed = match *c {
+            Coordinate::Mass { cw } => range(&root, problem.counterweights[cw].column),
+            Coordinate::Moment { cw, k } => range(&root, problem.counterweights[cw].column + 1 + k),
+            Coordinate::AnchorA { spring, i } => {
+                anchor_range(problem, &root, spring, 1 + i, &range)
+            }
+            Coordinate::AnchorB { spring, l } => {
+                let na = problem.springs[spring].axes_a.len();
+                anchor_range(problem, &root, spring, 1 + na + l, &range)
+            }
         };
-        if let Some([lo, hi]) =
-            base.lifted_range(problem, Some(&root), column, options.solver_iterations)
-        {
+        if let Some([lo, hi]) = narrowed {
             let r = &mut root.ranges[k];
             if lo > hi {
                 // Infeasible: keep the box; its relaxation proves it empty.
@@ -389,6 +403,48 @@ fn tighten(problem: &VariantProblem, mut root: NodeBox, options: &BranchOptions)
         }
     }
     root
+}
+
+/// The box a first search starts from: the case's bounds ([`NodeBox::root`]) narrowed by
+/// the bounds-only relaxation (see `tighten`).
+pub fn root_box(problem: &VariantProblem, options: &BranchOptions) -> Result<NodeBox, String> {
+    Ok(tighten(problem, NodeBox::root(problem)?, options))
+}
+
+/// The interval of the anchor component held at `offset` in spring `spring`'s lifted block
+/// (`K·a_i`), over the bounds-only relaxation on `root`: exactly `[0, 0]` when the family
+/// holds `K·a_i` at zero (its particular value and null-space row are zero), otherwise the
+/// quotient of `K·a_i`'s range by `K`'s (`K > 0`), `None` when either range is unknown.
+fn anchor_range(
+    problem: &VariantProblem,
+    root: &NodeBox,
+    spring: usize,
+    offset: usize,
+    range: &dyn Fn(&NodeBox, usize) -> Option<[f64; 2]>,
+) -> Option<[f64; 2]> {
+    let column = problem.springs[spring].column;
+    let lifted = column + offset;
+    let pinned = problem.particular[lifted] == 0.0
+        && (0..problem.dim()).all(|k| problem.nullspace[(lifted, k)] == 0.0);
+    if pinned {
+        return Some([0.0, 0.0]);
+    }
+    let [alo, ahi] = range(root, lifted)?;
+    let [klo, khi] = range(root, column)?;
+    if alo > ahi || klo > khi {
+        return Some([f64::INFINITY, f64::NEG_INFINITY]);
+    }
+    if klo.is_nan() || klo <= 0.0 {
+        // K may be near zero: only the sign of K·a_i carries over.
+        return Some([
+            if alo >= 0.0 { 0.0 } else { f64::NEG_INFINITY },
+            if ahi <= 0.0 { 0.0 } else { f64::INFINITY },
+        ]);
+    }
+    // a = α/K over α ∈ [alo, ahi], K ∈ [klo, khi] with 0 < klo.
+    let lo = if alo >= 0.0 { alo / khi } else { alo / klo };
+    let hi = if ahi >= 0.0 { ahi / klo } else { ahi / khi };
+    Some([lo, hi])
 }
 
 /// Branch-and-bound for the variant on `tasks`, starting from an optional design found
@@ -404,11 +460,18 @@ pub fn branch_and_bound(
     incumbent: Option<Design>,
     warm: Option<SearchState>,
 ) -> Result<(Verdict, SearchState), String> {
-    let (root, leaves) = match warm {
-        Some(w) => (w.root, Some(w.leaves)),
-        None => (tighten(problem, NodeBox::root(problem)?, options), None),
-    };
-    let base = RelaxationBase::new(problem, tasks, objective);
+    let (root, leaves, lagrange) =
+        match warm {
+            Some(w) => (w.root, Some(w.leaves), w.lagrange),
+            None => {
+                let root = root_box(problem, options)?;
+                let lagrange = RelaxationBase::new(problem, &[], Objective::Minimax)
+                    .lagrange_ranges(problem, Some(&root), options.solver_iterations);
+                (root, None, lagrange)
+            }
+        };
+    let base =
+        RelaxationBase::new(problem, tasks, objective).with_lagrange_bounds(problem, &lagrange);
     // Peak rows found active in any box so far: every later box starts with them.
     let mut active = Vec::new();
     let coords = coordinates(problem);
@@ -474,6 +537,7 @@ pub fn branch_and_bound(
             SearchState {
                 root: root.clone(),
                 leaves,
+                lagrange: lagrange.clone(),
             }
         };
         if open.is_empty() || closes(lowest, &best) {
