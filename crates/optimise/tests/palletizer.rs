@@ -490,33 +490,45 @@ fn a_hybrid_whose_boxes_propose_poor_designs_is_descended_to_a_better_one() {
 /// m. The case's bounds alone give `[−1, 1]` m (the anchor's reach) for both components; the
 /// search's first box must be narrowed to `ay = 0` (up to the relaxation's margin) and into
 /// that interval (and still hold the design the run finds).
-#[test]
-fn the_first_box_holds_an_anchor_component_balance_fixes_at_its_value() {
-    use counterpoise_optimise::certify::{BranchOptions, DEFAULT_MAX_NODES, node, root_box};
+/// A Dmax 3 variant of the palletizer, optimised with the default options: its result, its
+/// problem, the index of its spring `spring`, and the first box its search starts from.
+fn dmax3_variant(
+    labels: &[&str],
+    spring: &str,
+) -> (
+    counterpoise_optimise::OptimisedVariant,
+    counterpoise_optimise::problem::VariantProblem,
+    usize,
+    counterpoise_optimise::certify::node::NodeBox,
+) {
+    use counterpoise_optimise::certify::{BranchOptions, DEFAULT_MAX_NODES, root_box};
     let mut json = common::case_json("palletizer.json");
     json["balancing"]["dmax"] = serde_json::json!(3);
     let model = common::model(&json);
-    let (ctx, results) = common::optimise(
-        &model,
-        &[&["m4", "K32", "K73"]],
-        &OptimiseOptions::default(),
-    );
-    let problem = variant_problem(&ctx, &["m4", "K32", "K73"]);
-    let k73 = problem
+    let (ctx, mut results) = common::optimise(&model, &[labels], &OptimiseOptions::default());
+    let problem = variant_problem(&ctx, labels);
+    let index = problem
         .springs
         .iter()
-        .position(|s| s.label == "K73")
+        .position(|s| s.label == spring)
         .unwrap();
-    assert_eq!(problem.springs[k73].axes_a, vec![0, 1]);
-    let wide = node::NodeBox::root(&problem).unwrap();
-    assert_eq!(wide.anchor(&problem, k73, false, 0), [-1.0, 1.0]);
-    assert_eq!(wide.anchor(&problem, k73, false, 1), [-1.0, 1.0]);
     let options = BranchOptions {
         gap_tolerance: 1e-3,
         max_nodes: DEFAULT_MAX_NODES,
         solver_iterations: 200,
     };
     let root = root_box(&problem, &options).unwrap();
+    assert_eq!(results.len(), 1);
+    (results.pop().unwrap(), problem, index, root)
+}
+
+#[test]
+fn the_first_box_holds_an_anchor_component_balance_fixes_at_its_value() {
+    let (v, problem, k73, root) = dmax3_variant(&["m4", "K32", "K73"], "K73");
+    assert_eq!(problem.springs[k73].axes_a, vec![0, 1]);
+    let wide = counterpoise_optimise::certify::node::NodeBox::root(&problem).unwrap();
+    assert_eq!(wide.anchor(&problem, k73, false, 0), [-1.0, 1.0]);
+    assert_eq!(wide.anchor(&problem, k73, false, 1), [-1.0, 1.0]);
     // ay's range is 0 widened by the relaxation's relative margin (1e-6 of the reach).
     let [ylo, yhi] = root.anchor(&problem, k73, false, 1);
     assert!(
@@ -529,7 +541,6 @@ fn the_first_box_holds_an_anchor_component_balance_fixes_at_its_value() {
         (lo + 0.5).abs() < 1e-5 && (hi + 0.005).abs() < 1e-6,
         "ax ∈ [{lo}, {hi}]"
     );
-    let v = &results[0];
     assert!(v.is_feasible(), "{:?}", v.reason);
     let spring = v.springs.iter().find(|s| s.label == "K73").unwrap();
     let ax = spring.anchor_a[0];
@@ -550,29 +561,9 @@ fn the_first_box_holds_an_anchor_component_balance_fixes_at_its_value() {
 /// gap after 800 boxes; with it the search closes the gap.
 #[test]
 fn a_spring_that_carries_a_fixed_moment_bounds_its_anchor_through_the_lower_norm_bound() {
-    use counterpoise_optimise::certify::{BranchOptions, DEFAULT_MAX_NODES, root_box};
     use counterpoise_optimise::relaxation::{RelaxationBase, lagrange_terms};
-    let mut json = common::case_json("palletizer.json");
-    json["balancing"]["dmax"] = serde_json::json!(3);
-    let model = common::model(&json);
-    let (ctx, results) = common::optimise(
-        &model,
-        &[&["m5", "K63", "K65"]],
-        &OptimiseOptions::default(),
-    );
-    let problem = variant_problem(&ctx, &["m5", "K63", "K65"]);
-    let k63 = problem
-        .springs
-        .iter()
-        .position(|s| s.label == "K63")
-        .unwrap();
+    let (v, problem, k63, root) = dmax3_variant(&["m5", "K63", "K65"], "K63");
     assert_eq!(lagrange_terms(&problem.springs[k63]).len(), 2);
-    let options = BranchOptions {
-        gap_tolerance: 1e-3,
-        max_nodes: DEFAULT_MAX_NODES,
-        solver_iterations: 200,
-    };
-    let root = root_box(&problem, &options).unwrap();
     let ranges = RelaxationBase::new(&problem, &[], counterpoise_optimise::Objective::Minimax)
         .lagrange_ranges(&problem, Some(&root), 200);
     let moment = 5382747.0 / 8000.0;
@@ -587,7 +578,6 @@ fn a_spring_that_carries_a_fixed_moment_bounds_its_anchor_through_the_lower_norm
         cross[0] <= moment && moment <= cross[1] && cross[1] - cross[0] < 2e-2,
         "K (a×b)_z ∈ {cross:?}"
     );
-    let v = &results[0];
     assert!(v.is_feasible(), "{:?}", v.reason);
     let (objective, lower) = (v.objective.unwrap(), v.lower_bound.unwrap());
     let gap = (objective - lower) / objective;
