@@ -550,6 +550,25 @@ fn the_first_box_holds_an_anchor_component_balance_fixes_at_its_value() {
     );
     let k32 = v.springs.iter().find(|s| s.label == "K32").unwrap();
     assert!((k32.stiffness + 20.0 * spring.stiffness * ax).abs() < 1e-6 * k32.stiffness);
+    // Every anchor component of the design, a and b of both springs, lies in the first box.
+    for (k, slot) in problem.springs.iter().enumerate() {
+        let design = v.springs.iter().find(|s| s.label == slot.label).unwrap();
+        for (is_b, axes, anchor) in [
+            (false, &slot.axes_a, design.anchor_a),
+            (true, &slot.axes_b, design.anchor_b),
+        ] {
+            for (i, &axis) in axes.iter().enumerate() {
+                let [lo, hi] = root.anchor(&problem, k, is_b, i);
+                let x = anchor[axis];
+                assert!(
+                    lo <= x && x <= hi,
+                    "{} anchor {} axis {axis}: {x} outside [{lo}, {hi}]",
+                    slot.label,
+                    if is_b { "b" } else { "a" }
+                );
+            }
+        }
+    }
 }
 
 /// `m5 + K63 + K65` balances only with `K63·(ax·bx + ay·by) = 0` and
