@@ -146,6 +146,9 @@ pub struct ConicProblem {
     /// Optimality and feasibility tolerance of the first runs, when not clarabel's 1e-8 (see
     /// [`ConicProblem::set_tolerance`]).
     tolerance: Option<f64>,
+    /// Solves tried at most (clarabel's first run and its retries, see
+    /// [`ConicProblem::solve`]); `None` for all of them.
+    attempts: Option<u32>,
 }
 
 /// The outcome of a solve.
@@ -229,6 +232,12 @@ impl ConicProblem {
         self.tolerance = Some(tol);
     }
 
+    /// Tries at most `attempts` of the solves [`ConicProblem::solve`] would try (at least one):
+    /// for a problem whose caller has a cheaper fallback than the cautious retries.
+    pub fn limit_attempts(&mut self, attempts: u32) {
+        self.attempts = Some(attempts.max(1));
+    }
+
     pub fn rows(&self) -> usize {
         self.rows.len()
     }
@@ -240,7 +249,7 @@ impl ConicProblem {
     /// wins, otherwise the last status is returned.
     pub fn solve(&self, max_iter: u32) -> ConicSolution {
         let mut last = self.solve_attempt(max_iter, 0);
-        for attempt in 1..ATTEMPTS {
+        for attempt in 1..self.attempts.unwrap_or(ATTEMPTS).min(ATTEMPTS) {
             if last.status == ConicStatus::Solved
                 || last.status.is_infeasible()
                 || last.status == ConicStatus::SetupFailed
@@ -366,6 +375,46 @@ mod tests {
         dy.constant = -2.0;
         p.soc(&Affine::var(t), &[dx, dy]);
         let s = p.solve(100);
+        assert_eq!(s.status, ConicStatus::Solved);
+        assert!((s.objective - 3.0 / 2f64.sqrt()).abs() < 1e-7);
+    }
+
+    #[test]
+    fn limited_attempts_stop_the_retries() {
+        // min t s.t. t ≥ ‖(x − 1, y − 2)‖, x + y = 0 (as in `small_socp`), with one iteration
+        // per run: no run can reach the optimum, so every allowed run is tried.
+        let mut p = ConicProblem::default();
+        let (x, y, t) = (p.new_variable(), p.new_variable(), p.new_variable());
+        p.objective[t] = 1.0;
+        let mut sum = Affine::var(x);
+        sum.add_var(y, 1.0);
+        p.equal_zero(&sum);
+        let mut dx = Affine::var(x);
+        dx.constant = -1.0;
+        let mut dy = Affine::var(y);
+        dy.constant = -2.0;
+        p.soc(&Affine::var(t), &[dx, dy]);
+        let all = p.solve(1);
+        assert_ne!(all.status, ConicStatus::Solved);
+        assert_eq!(all.attempts, ATTEMPTS);
+        for limit in [1, 2] {
+            let mut q = p.clone();
+            q.limit_attempts(limit);
+            let s = q.solve(1);
+            assert_ne!(s.status, ConicStatus::Solved);
+            assert_eq!(s.attempts, limit);
+        }
+        // A limit of zero still runs clarabel once; a limit never adds runs.
+        let mut q = p.clone();
+        q.limit_attempts(0);
+        assert_eq!(q.solve(1).attempts, 1);
+        let mut q = p.clone();
+        q.limit_attempts(ATTEMPTS + 3);
+        assert_eq!(q.solve(1).attempts, ATTEMPTS);
+        // With iterations enough, the limited problem solves on its first run as before.
+        let mut q = p.clone();
+        q.limit_attempts(1);
+        let s = q.solve(100);
         assert_eq!(s.status, ConicStatus::Solved);
         assert!((s.objective - 3.0 / 2f64.sqrt()).abs() < 1e-7);
     }

@@ -307,6 +307,18 @@ impl RelaxationBase {
         built.solve(problem, max_iter, active)
     }
 
+    /// Rows of the conic problem (without a node's rows or peak rows).
+    pub fn rows(&self) -> usize {
+        self.0.cp.rows()
+    }
+
+    /// This relaxation, solved with at most `attempts` of clarabel's runs per solve (see
+    /// [`crate::clarabel_map::ConicProblem::limit_attempts`]).
+    pub fn limit_attempts(mut self, attempts: u32) -> Self {
+        self.0.cp.limit_attempts(attempts);
+        self
+    }
+
     /// The range of lifted variable `column` over this relaxation restricted to `node` (an
     /// interval that holds every physical point of the box): two solves, minimising and
     /// maximising it, with the task objective dropped. `None` when either solve does not end

@@ -484,12 +484,6 @@ fn a_hybrid_whose_boxes_propose_poor_designs_is_descended_to_a_better_one() {
     assert!(v.verification.as_ref().unwrap().passed);
 }
 
-/// `m4 + K32 + K73` balances only with `K73·ay = 0` and `K32 + 20·K73·ax = 0` (the relations
-/// the balance search prints), so every physical spring has K73's anchor on its body's x axis
-/// at `ax = −K32/(20·K73)`: with both stiffnesses in `[1000, 10000]` N/m, `ax ∈ [−0.5, −0.005]`
-/// m. The case's bounds alone give `[−1, 1]` m (the anchor's reach) for both components; the
-/// search's first box must be narrowed to `ay = 0` (up to the relaxation's margin) and into
-/// that interval (and still hold the design the run finds).
 /// A Dmax 3 variant of the palletizer, optimised with the default options: its result, its
 /// problem, the index of its spring `spring`, and the first box its search starts from.
 fn dmax3_variant(
@@ -522,6 +516,12 @@ fn dmax3_variant(
     (results.pop().unwrap(), problem, index, root)
 }
 
+/// `m4 + K32 + K73` balances only with `K73·ay = 0` and `K32 + 20·K73·ax = 0` (the relations
+/// the balance search prints), so every physical spring has K73's anchor on its body's x axis
+/// at `ax = −K32/(20·K73)`: with both stiffnesses in `[1000, 10000]` N/m, `ax ∈ [−0.5, −0.005]`
+/// m. The case's bounds alone give `[−1, 1]` m (the anchor's reach) for both components; the
+/// search's first box must be narrowed to `ay = 0` (up to the relaxation's margin) and into
+/// that interval (and still hold the design the run finds).
 #[test]
 fn the_first_box_holds_an_anchor_component_balance_fixes_at_its_value() {
     let (v, problem, k73, root) = dmax3_variant(&["m4", "K32", "K73"], "K73");
@@ -610,4 +610,42 @@ fn a_spring_that_carries_a_fixed_moment_bounds_its_anchor_through_the_lower_norm
     );
     let b_norm = (b[0] * b[0] + b[1] * b[1]).sqrt();
     assert!(s.stiffness * b_norm <= moment / 0.25 * (1.0 + 1e-6));
+}
+
+/// `m5 + K52 + K53` balances only with `K53 + 4·K53·ax = 0`, `K53·ay = 0`, `K53·bx = 0` and
+/// `K53·by = 1794249/800` N (the relations the balance search prints): K53's anchors are
+/// `a = (−0.25, 0)` m and `b = (0, 2242.81125/K53)`, so `|b| ≤ 0.5` m needs
+/// `K53 ≥ 1794249/400 = 4485.6225` N/m, and the Lagrange vector is the point
+/// `(0, −0.25·2242.81125)`. The optimum sits on that cap (`by = 0.5` m). With the Lagrange
+/// cones clarabel stalls on many of this variant's boxes near the cap (158 of 458 undecided
+/// after all four of its runs, each box then split with its parent's bound: 339 boxes to close
+/// the gap); a box the cones leave undecided is now solved without them, and the gap closes
+/// within 250 boxes.
+#[test]
+fn a_box_the_lagrange_cones_leave_undecided_is_bounded_without_them() {
+    let mut json = common::case_json("palletizer.json");
+    json["balancing"]["dmax"] = serde_json::json!(3);
+    let model = common::model(&json);
+    let options = OptimiseOptions {
+        max_nodes: 250,
+        ..OptimiseOptions::default()
+    };
+    let (_, results) = common::optimise(&model, &[&["m5", "K52", "K53"]], &options);
+    let v = &results[0];
+    assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
+    let (objective, lower) = (v.objective.unwrap(), v.lower_bound.unwrap());
+    let gap = (objective - lower) / objective;
+    assert!((0.0..=1e-3).contains(&gap), "gap {gap:e}");
+    assert!(v.verification.as_ref().unwrap().passed);
+    let s = v.springs.iter().find(|s| s.label == "K53").unwrap();
+    let (a, b, k) = (s.anchor_a, s.anchor_b, s.stiffness);
+    assert!((a[0] + 0.25).abs() < 1e-9 && a[1].abs() < 1e-9, "a = {a:?}");
+    assert!(b[0].abs() < 1e-9, "b = {b:?}");
+    assert!(
+        (k * b[1] - 1794249.0 / 800.0).abs() < 1e-6 * k,
+        "K·by = {}",
+        k * b[1]
+    );
+    assert!(k >= 1794249.0 / 400.0 * (1.0 - 1e-9), "K53 = {k}");
+    assert!(b[1] <= 0.5 * (1.0 + 1e-9), "by = {}", b[1]);
 }

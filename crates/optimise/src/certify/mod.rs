@@ -139,8 +139,12 @@ pub struct SearchState {
     leaves: Vec<(NodeBox, f64)>,
     /// Per spring, the intervals of its Lagrange vector over the root box
     /// ([`RelaxationBase::lagrange_ranges`]; they hold for every task set).
-    lagrange: Vec<Vec<[f64; 2]>>,
+    lagrange: LagrangeRanges,
 }
+
+/// Per spring, the intervals of its Lagrange vector's components (empty for a spring without
+/// them; see [`RelaxationBase::lagrange_ranges`]).
+type LagrangeRanges = Vec<Vec<[f64; 2]>>;
 
 impl SearchState {
     /// Boxes the next search starts from.
@@ -157,11 +161,29 @@ impl SearchState {
     }
 }
 
+/// The relaxations a search solves its boxes with: `first`, and where it is given, `fallback`
+/// for a box on which `first` ends short of a verdict.
+///
+/// With the Lagrange cones ([`RelaxationBase::with_lagrange_bounds`]) clarabel sometimes
+/// stalls on a box whose relaxation is infeasible or nearly so (on the palletizer at Dmax 3,
+/// m5 + K52 + K53: 158 of its 458 boxes ended `InsufficientProgress` or `AlmostSolved` after
+/// all four of clarabel's runs, so each kept its parent's bound and was split again). The
+/// relaxation without the cones is weaker but valid, and clarabel seldom stalls on it where
+/// it stalls with them: so the cones get two of clarabel's runs (the first and the cautious
+/// retry, which rescues most boxes of m4 + K32 + K73), and a box they leave undecided is
+/// solved without the cones, also with two runs (where that relaxation stalls too, as on some
+/// boxes of m3 + m5 + K72, its last two runs rarely succeed either). A box costs at most the
+/// four runs it had before; m5 + K52 + K53 closes its gap in 155 boxes instead of 339.
+struct Bases<'a> {
+    first: &'a RelaxationBase,
+    fallback: Option<&'a RelaxationBase>,
+}
+
 /// Solves the relaxation on `node`; `None` when the box is proved to hold no point (the
 /// relaxation is infeasible, or an anchor's lower norm bound excludes the whole box).
 fn bound_box(
     problem: &VariantProblem,
-    base: &RelaxationBase,
+    bases: &Bases<'_>,
     active: &mut Vec<bool>,
     options: &BranchOptions,
     node: NodeBox,
@@ -171,7 +193,15 @@ fn bound_box(
     if node.is_empty() || node.inside_anchor_floor(problem).is_some() {
         return None;
     }
-    let relaxed = base.solve(problem, Some(&node), options.solver_iterations, active);
+    let mut relaxed = bases
+        .first
+        .solve(problem, Some(&node), options.solver_iterations, active);
+    if let Some(fallback) = bases.fallback
+        && relaxed.solution.status != ConicStatus::Solved
+        && !relaxed.solution.status.is_infeasible()
+    {
+        relaxed = fallback.solve(problem, Some(&node), options.solver_iterations, active);
+    }
     match relaxed.solution.status {
         ConicStatus::PrimalInfeasible => None,
         ConicStatus::Solved if relaxed.z.iter().all(|v| v.is_finite()) => Some(Open {
@@ -374,9 +404,13 @@ fn branching_coordinate(
 ///   point 0, and one whose lifted value keeps a sign keeps it. Left wide, such a component
 ///   spoils the anchors' lower norm bound: the secant of `a_y²` over `[−r, r]` is `r²` at
 ///   `a_y = 0`, so `|a| ≥ a_min` never cuts until the search has split the pinned coordinate.
-fn tighten(problem: &VariantProblem, mut root: NodeBox, options: &BranchOptions) -> NodeBox {
+fn tighten(
+    problem: &VariantProblem,
+    base: &RelaxationBase,
+    mut root: NodeBox,
+    options: &BranchOptions,
+) -> NodeBox {
     let coords = coordinates(problem);
-    let base = RelaxationBase::new(problem, &[], Objective::Minimax);
     let range = |root: &NodeBox, column: usize| {
         base.lifted_range(problem, Some(root), column, options.solver_iterations)
     };
@@ -408,7 +442,19 @@ fn tighten(problem: &VariantProblem, mut root: NodeBox, options: &BranchOptions)
 /// The box a first search starts from: the case's bounds ([`NodeBox::root`]) narrowed by
 /// the bounds-only relaxation (see `tighten`).
 pub fn root_box(problem: &VariantProblem, options: &BranchOptions) -> Result<NodeBox, String> {
-    Ok(tighten(problem, NodeBox::root(problem)?, options))
+    Ok(first_box(problem, options)?.0)
+}
+
+/// The first box ([`root_box`]) and each spring's Lagrange ranges over it
+/// ([`RelaxationBase::lagrange_ranges`]), both from one bounds-only relaxation.
+fn first_box(
+    problem: &VariantProblem,
+    options: &BranchOptions,
+) -> Result<(NodeBox, LagrangeRanges), String> {
+    let bounds_only = RelaxationBase::new(problem, &[], Objective::Minimax);
+    let root = tighten(problem, &bounds_only, NodeBox::root(problem)?, options);
+    let lagrange = bounds_only.lagrange_ranges(problem, Some(&root), options.solver_iterations);
+    Ok((root, lagrange))
 }
 
 /// The interval of the anchor component held at `offset` in spring `spring`'s lifted block
@@ -460,18 +506,24 @@ pub fn branch_and_bound(
     incumbent: Option<Design>,
     warm: Option<SearchState>,
 ) -> Result<(Verdict, SearchState), String> {
-    let (root, leaves, lagrange) =
-        match warm {
-            Some(w) => (w.root, Some(w.leaves), w.lagrange),
-            None => {
-                let root = root_box(problem, options)?;
-                let lagrange = RelaxationBase::new(problem, &[], Objective::Minimax)
-                    .lagrange_ranges(problem, Some(&root), options.solver_iterations);
-                (root, None, lagrange)
-            }
-        };
-    let base =
-        RelaxationBase::new(problem, tasks, objective).with_lagrange_bounds(problem, &lagrange);
+    let (root, leaves, lagrange) = match warm {
+        Some(w) => (w.root, Some(w.leaves), w.lagrange),
+        None => {
+            let (root, lagrange) = first_box(problem, options)?;
+            (root, None, lagrange)
+        }
+    };
+    let plain = RelaxationBase::new(problem, tasks, objective);
+    let base = plain.clone().with_lagrange_bounds(problem, &lagrange);
+    let (base, fallback) = if base.rows() > plain.rows() {
+        (base.limit_attempts(2), Some(plain.limit_attempts(2)))
+    } else {
+        (base, None)
+    };
+    let bases = Bases {
+        first: &base,
+        fallback: fallback.as_ref(),
+    };
     // Peak rows found active in any box so far: every later box starts with them.
     let mut active = Vec::new();
     let coords = coordinates(problem);
@@ -502,7 +554,7 @@ pub fn branch_and_bound(
             nodes += 1;
             if let Some(o) = bound_box(
                 problem,
-                &base,
+                &bases,
                 &mut active,
                 options,
                 root.clone(),
@@ -590,7 +642,7 @@ pub fn branch_and_bound(
             nodes += 1;
             if let Some(o) = bound_box(
                 problem,
-                &base,
+                &bases,
                 &mut active,
                 options,
                 current.node,
@@ -657,7 +709,7 @@ pub fn branch_and_bound(
                     *nodes += 1;
                     bound_box(
                         problem,
-                        &base,
+                        &bases,
                         &mut active,
                         options,
                         child,
