@@ -224,6 +224,52 @@ fn bound_box(
     }
 }
 
+/// [`bound_box`] of several boxes (with their orders), solved in parallel on the current rayon
+/// pool: the children of one split, or of two splits under strong branching. Each starts from
+/// the peak rows `active` marks on entry, and `active` returns every row any of them used; so
+/// the result does not depend on the thread count or on which box finishes first. (A search
+/// on one variant keeps both cores busy where it is the last variant of a pass left running.)
+fn bound_boxes(
+    problem: &VariantProblem,
+    bases: &Bases<'_>,
+    active: &mut Vec<bool>,
+    options: &BranchOptions,
+    boxes: Vec<(NodeBox, usize)>,
+    parent_bound: f64,
+) -> Vec<Option<Open>> {
+    use rayon::prelude::*;
+    let start = active.clone();
+    let solved: Vec<(Option<Open>, Vec<bool>)> = boxes
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|(node, order)| {
+            let mut rows = start.clone();
+            let open = bound_box(
+                problem,
+                bases,
+                &mut rows,
+                options,
+                node,
+                parent_bound,
+                order,
+            );
+            (open, rows)
+        })
+        .collect();
+    solved
+        .into_iter()
+        .map(|(open, rows)| {
+            if rows.len() > active.len() {
+                active.resize(rows.len(), false);
+            }
+            for (a, r) in active.iter_mut().zip(rows) {
+                *a |= r;
+            }
+            open
+        })
+        .collect()
+}
+
 /// The design at a full lifted point with realized springs, if it meets every bound and peak
 /// limit on the tasks searched (and every counterweight has a positive mass).
 fn verified_design(
@@ -702,34 +748,29 @@ pub fn branch_and_bound(
             stuck.push((current.node, current.bound));
             continue;
         };
-        let mut solve_children = |k: usize, nodes: &mut usize| -> Vec<Option<Open>> {
-            (0..2)
-                .zip(current.node.split(k))
-                .map(|(c, child)| {
-                    *nodes += 1;
-                    bound_box(
-                        problem,
-                        &bases,
-                        &mut active,
-                        options,
-                        child,
-                        current.bound,
-                        order + 1 + c,
-                    )
-                })
-                .collect()
-        };
-        let mut children = solve_children(k, &mut nodes);
         // Where the counterweights' relaxation is loose, the springs' may be too, and which
         // split raises the bound more is not known in advance: on the palletizer at Dmax 3,
         // splitting only the counterweights of m3 + m5 + K42 left its relaxed K42 anchor inside
         // the anchor's lower norm bound and a 6.4 % gap after 3,200 boxes. So the spring split
         // is solved too, and the pair of children that raises the bound more is kept (strong
         // branching; the counterweight split on a tie). Both pairs count as boxes solved.
-        if counterweights_first
-            && let Some(ks) = branching_coordinate(problem, &coords, &root, &current, false)
-            && ks != k
-        {
+        let alternative_split = if counterweights_first {
+            branching_coordinate(problem, &coords, &root, &current, false).filter(|&ks| ks != k)
+        } else {
+            None
+        };
+        let splits: Vec<usize> = std::iter::once(k).chain(alternative_split).collect();
+        let boxes: Vec<(NodeBox, usize)> = splits
+            .iter()
+            .flat_map(|&k| current.node.split(k))
+            .enumerate()
+            .map(|(n, child)| (child, order + 1 + n % 2))
+            .collect();
+        nodes += boxes.len();
+        let mut solved = bound_boxes(problem, &bases, &mut active, options, boxes, current.bound);
+        let alternative = solved.split_off(2);
+        let mut children = solved;
+        if !alternative.is_empty() {
             // The product rule of strong branching: each child's rise above the parent bound
             // (an empty child rises by the parent's magnitude), floored so that a split that
             // raises one child only still counts.
@@ -743,7 +784,6 @@ pub fn branch_and_bound(
                     })
                     .product::<f64>()
             };
-            let alternative = solve_children(ks, &mut nodes);
             if score(&alternative) > score(&children) {
                 children = alternative;
             }

@@ -450,6 +450,65 @@ fn a_search_resumed_on_more_tasks_ends_where_a_fresh_one_does() {
     );
 }
 
+/// The children of a split are solved in parallel (`certify::bound_boxes`), each from the peak
+/// rows known before the split: the search must end with the same bits in a pool of one thread
+/// and of two (the pendulum hybrid splits both its anchors and its counterweight, with strong
+/// branching, over hundreds of boxes).
+#[test]
+fn a_search_gives_the_same_bits_on_one_thread_and_on_two() {
+    let (_, ctx, variant) = pendulum_m1_k10(5.0, true);
+    let options = OptimiseOptions::default();
+    let run = new_run(&ctx, &variant, &options);
+    let problem = run.problem.as_ref().unwrap();
+    let tasks: Vec<usize> = (0..ctx.tasks.len().min(6)).collect();
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &tasks);
+    let branch = BranchOptions {
+        gap_tolerance: options.gap_tolerance,
+        max_nodes: 2000,
+        solver_iterations: options.solver_iterations,
+    };
+    let b = &ctx.basis.unbalanced;
+    let search_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            branch_and_bound(problem, b, &tasks, options.objective, &branch, None, None).unwrap()
+        })
+    };
+    let outcome = |v: Verdict| match v {
+        Verdict::Optimal {
+            design,
+            lower_bound,
+            nodes,
+        } => (
+            design.value.to_bits(),
+            design.x.clone(),
+            lower_bound.to_bits(),
+            nodes,
+        ),
+        other => panic!("the search must end optimal: {other:?}"),
+    };
+    let (one, one_state) = search_on(1);
+    let (two, two_state) = search_on(2);
+    let (one, two) = (outcome(one), outcome(two));
+    assert!(
+        one.3 > 20,
+        "only {} boxes: the test needs a real search",
+        one.3
+    );
+    assert_eq!(one.0, two.0, "design value");
+    assert_eq!(one.1, two.1, "design point");
+    assert_eq!(one.2, two.2, "lower bound");
+    assert_eq!(one.3, two.3, "boxes");
+    assert_eq!(one_state.boxes(), two_state.boxes());
+    assert_eq!(
+        one_state.smallest_bound().to_bits(),
+        two_state.smallest_bound().to_bits()
+    );
+}
+
 /// A search without a design may spend four times `max_nodes` boxes before it stops: a proof
 /// of impossibility that needs `n` boxes ends `Impossible` with a limit of `⌈n/4⌉`, and stops
 /// `undecided` (no design) below `n/4`. The pendulum with a counterweight m1 of at most 0.1 kg
