@@ -507,7 +507,7 @@ fn first_box(
 /// (`K·a_i`), over the bounds-only relaxation on `root`: exactly `[0, 0]` when the family
 /// holds `K·a_i` at zero (its particular value and null-space row are zero), otherwise the
 /// quotient of `K·a_i`'s range by `K`'s (`K > 0`), `None` when either range is unknown.
-fn anchor_range(
+pub(crate) fn anchor_range(
     problem: &VariantProblem,
     root: &NodeBox,
     spring: usize,

@@ -626,3 +626,72 @@ fn batched_reaction_peaks_equal_each_group_on_its_own() {
     let over_a = reaction_peaks(&ctx, &c, &ta).unwrap();
     assert_ne!(over_a, *batched[2].as_ref().unwrap());
 }
+
+/// The first box's anchor interval from the ranges of `K·a_i` and `K` (`certify::anchor_range`),
+/// by hand for each case of its quotient `a_i = (K·a_i)/K`, with the ranges given directly:
+/// `K ∈ [2, 4]` and `K·a_i ∈ [1, 3]` give `[1/4, 3/2]`; `[−3, −1]` gives `[−3/2, −1/4]`; `[−1, 3]`
+/// gives `[−1/2, 3/2]`; with `K ∈ [0, 4]` (a stiffness that may vanish) only the sign of `K·a_i`
+/// carries over; an empty range is an empty interval, an unknown one no interval. A component
+/// the family holds at exactly zero (its particular value and null-space row zero) is the point
+/// 0 without a range being asked for.
+#[test]
+fn an_anchor_interval_is_the_quotient_of_the_lifted_ranges() {
+    use crate::certify::anchor_range;
+    use crate::certify::node::NodeBox;
+    let (_, ctx, variant) = pendulum_m1_k10(5.0, true);
+    let run = new_run(&ctx, &variant, &OptimiseOptions::default());
+    let problem = run.problem.as_ref().unwrap();
+    let root = NodeBox::root(problem).unwrap();
+    let column = problem.springs[0].column;
+    let lifted = column + 1;
+    let interval = |k: Option<[f64; 2]>, ka: Option<[f64; 2]>| {
+        let range = |_: &NodeBox, c: usize| {
+            if c == column {
+                k
+            } else {
+                assert_eq!(c, lifted);
+                ka
+            }
+        };
+        anchor_range(problem, &root, 0, 1, &range)
+    };
+    let k = Some([2.0, 4.0]);
+    assert_eq!(interval(k, Some([1.0, 3.0])), Some([0.25, 1.5]));
+    assert_eq!(interval(k, Some([-3.0, -1.0])), Some([-1.5, -0.25]));
+    assert_eq!(interval(k, Some([-1.0, 3.0])), Some([-0.5, 1.5]));
+    assert_eq!(interval(k, Some([0.0, 0.0])), Some([0.0, 0.0]));
+    let soft = Some([0.0, 4.0]);
+    assert_eq!(interval(soft, Some([1.0, 3.0])), Some([0.0, f64::INFINITY]));
+    assert_eq!(
+        interval(soft, Some([-3.0, -1.0])),
+        Some([f64::NEG_INFINITY, 0.0])
+    );
+    assert_eq!(
+        interval(soft, Some([-1.0, 3.0])),
+        Some([f64::NEG_INFINITY, f64::INFINITY])
+    );
+    assert_eq!(
+        interval(Some([f64::NAN, 4.0]), Some([1.0, 3.0])),
+        Some([0.0, f64::INFINITY])
+    );
+    for (k, ka) in [(k, Some([1.0, 0.0])), (Some([4.0, 2.0]), Some([1.0, 3.0]))] {
+        let [lo, hi] = interval(k, ka).unwrap();
+        assert!(lo > hi, "an empty range gives [{lo}, {hi}]");
+    }
+    assert_eq!(interval(None, Some([1.0, 3.0])), None);
+    assert_eq!(interval(k, None), None);
+    // Held at zero by the family itself: no range is asked for.
+    let mut pinned = problem.clone();
+    pinned.particular[lifted] = 0.0;
+    pinned.nullspace.row_mut(lifted).fill(0.0);
+    let never = |_: &NodeBox, _: usize| -> Option<[f64; 2]> { panic!("no range is needed") };
+    assert_eq!(anchor_range(&pinned, &root, 0, 1, &never), Some([0.0, 0.0]));
+    // One entry of the row not zero: the range is asked for.
+    let mut almost = pinned.clone();
+    almost.nullspace[(lifted, 0)] = 1e-300;
+    let asked = |_: &NodeBox, _: usize| Some([1.0, 1.0]);
+    assert_eq!(anchor_range(&almost, &root, 0, 1, &asked), Some([1.0, 1.0]));
+    let mut almost = pinned.clone();
+    almost.particular[lifted] = 1e-300;
+    assert_eq!(anchor_range(&almost, &root, 0, 1, &asked), Some([1.0, 1.0]));
+}
