@@ -115,12 +115,12 @@ pub enum Verdict {
 }
 
 /// One open box with its relaxation.
-struct Open {
-    bound: f64,
+pub(crate) struct Open {
+    pub(crate) bound: f64,
     order: usize,
     node: NodeBox,
     /// The relaxed free coordinates, when the relaxation was solved.
-    z: Option<DVector<f64>>,
+    pub(crate) z: Option<DVector<f64>>,
     /// The relaxation's error per counterweight ([`crate::relaxation::Relaxed::cw_errors`]).
     cw_errors: Vec<f64>,
     /// Whether the bound is from an earlier search on fewer tasks (still a lower bound, but
@@ -174,14 +174,14 @@ impl SearchState {
 /// solved without the cones, also with two runs (where that relaxation stalls too, as on some
 /// boxes of m3 + m5 + K72, its last two runs rarely succeed either). A box costs at most the
 /// four runs it had before; m5 + K52 + K53 closes its gap in 155 boxes instead of 339.
-struct Bases<'a> {
-    first: &'a RelaxationBase,
-    fallback: Option<&'a RelaxationBase>,
+pub(crate) struct Bases<'a> {
+    pub(crate) first: &'a RelaxationBase,
+    pub(crate) fallback: Option<&'a RelaxationBase>,
 }
 
 /// Solves the relaxation on `node`; `None` when the box is proved to hold no point (the
 /// relaxation is infeasible, or an anchor's lower norm bound excludes the whole box).
-fn bound_box(
+pub(crate) fn bound_box(
     problem: &VariantProblem,
     bases: &Bases<'_>,
     active: &mut Vec<bool>,
@@ -229,7 +229,7 @@ fn bound_box(
 /// the peak rows `active` marks on entry, and `active` returns every row any of them used; so
 /// the result does not depend on the thread count or on which box finishes first. (A search
 /// on one variant keeps both cores busy where it is the last variant of a pass left running.)
-fn bound_boxes(
+pub(crate) fn bound_boxes(
     problem: &VariantProblem,
     bases: &Bases<'_>,
     active: &mut Vec<bool>,

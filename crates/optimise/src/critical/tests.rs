@@ -695,3 +695,76 @@ fn an_anchor_interval_is_the_quotient_of_the_lifted_ranges() {
     almost.particular[lifted] = 1e-300;
     assert_eq!(anchor_range(&almost, &root, 0, 1, &asked), Some([1.0, 1.0]));
 }
+
+/// The children of a split solved together (`certify::bound_boxes`) give each child the bound
+/// and relaxed point it has solved alone from the same peak rows, and leave marked every peak
+/// row any child used: the union of the rows each child, solved alone, reports. On the
+/// palletizer's m4 + K72 with peak limits low enough to bind, the first box's two halves along
+/// each coordinate are solved from no marked row.
+#[test]
+fn boxes_solved_together_are_the_boxes_solved_alone() {
+    use crate::certify::node::NodeBox;
+    use crate::certify::{Bases, bound_box, bound_boxes, root_box};
+    use crate::relaxation::RelaxationBase;
+    let mut json = case_json("palletizer.json");
+    // Below the unbalanced robot's peaks, so that the relaxations need the peak rows.
+    json["balancing"]["peak_limits"] = serde_json::json!({ "M1": 20, "M2": 12, "M3": 9 });
+    let model = model(&json);
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let run = run_after_loop(&ctx, &balanced_variant(&model, &["m4", "K72"]), &options);
+    let problem = run.problem.as_ref().unwrap();
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+    let branch = BranchOptions {
+        gap_tolerance: options.gap_tolerance,
+        max_nodes: options.max_nodes,
+        solver_iterations: options.solver_iterations,
+    };
+    let base = RelaxationBase::new(problem, &tasks, options.objective);
+    let bases = Bases {
+        first: &base,
+        fallback: None,
+    };
+    let root = root_box(problem, &branch).unwrap();
+    let mut rows_used = 0;
+    for k in 0..root.ranges.len() {
+        let boxes: Vec<(NodeBox, usize)> = root.split(k).into_iter().zip([1, 2]).collect();
+        let mut together = Vec::new();
+        let solved = bound_boxes(
+            problem,
+            &bases,
+            &mut together,
+            &branch,
+            boxes.clone(),
+            f64::NEG_INFINITY,
+        );
+        let mut union: Vec<bool> = Vec::new();
+        for ((node, order), open) in boxes.into_iter().zip(&solved) {
+            let mut alone = Vec::new();
+            let expected = bound_box(
+                problem,
+                &bases,
+                &mut alone,
+                &branch,
+                node,
+                f64::NEG_INFINITY,
+                order,
+            );
+            assert_eq!(
+                open.as_ref().map(|o| (o.bound.to_bits(), o.z.clone())),
+                expected.as_ref().map(|o| (o.bound.to_bits(), o.z.clone())),
+                "coordinate {k}"
+            );
+            union.resize(union.len().max(alone.len()), false);
+            for (u, a) in union.iter_mut().zip(alone) {
+                *u |= a;
+            }
+        }
+        assert_eq!(together, union, "coordinate {k}");
+        rows_used += union.iter().filter(|&&r| r).count();
+    }
+    assert!(
+        rows_used > 0,
+        "no child used a peak row: the test proves nothing"
+    );
+}
