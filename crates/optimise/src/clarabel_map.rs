@@ -360,9 +360,8 @@ impl ConicProblem {
 mod tests {
     use super::*;
 
-    #[test]
-    fn small_socp() {
-        // min t s.t. t ≥ ‖(x − 1, y − 2)‖, x + y = 0 → distance from (1, 2) to the line: 3/√2.
+    /// min t s.t. t ≥ ‖(x − 1, y − 2)‖, x + y = 0: the distance from (1, 2) to the line, 3/√2.
+    fn distance_to_line() -> ConicProblem {
         let mut p = ConicProblem::default();
         let (x, y, t) = (p.new_variable(), p.new_variable(), p.new_variable());
         p.objective[t] = 1.0;
@@ -374,26 +373,21 @@ mod tests {
         let mut dy = Affine::var(y);
         dy.constant = -2.0;
         p.soc(&Affine::var(t), &[dx, dy]);
-        let s = p.solve(100);
+        p
+    }
+
+    #[test]
+    fn small_socp() {
+        let s = distance_to_line().solve(100);
         assert_eq!(s.status, ConicStatus::Solved);
         assert!((s.objective - 3.0 / 2f64.sqrt()).abs() < 1e-7);
     }
 
     #[test]
     fn limited_attempts_stop_the_retries() {
-        // min t s.t. t ≥ ‖(x − 1, y − 2)‖, x + y = 0 (as in `small_socp`), with one iteration
-        // per run: no run can reach the optimum, so every allowed run is tried.
-        let mut p = ConicProblem::default();
-        let (x, y, t) = (p.new_variable(), p.new_variable(), p.new_variable());
-        p.objective[t] = 1.0;
-        let mut sum = Affine::var(x);
-        sum.add_var(y, 1.0);
-        p.equal_zero(&sum);
-        let mut dx = Affine::var(x);
-        dx.constant = -1.0;
-        let mut dy = Affine::var(y);
-        dy.constant = -2.0;
-        p.soc(&Affine::var(t), &[dx, dy]);
+        // `distance_to_line` with one iteration per run: no run can reach the optimum, so every
+        // allowed run is tried.
+        let p = distance_to_line();
         let all = p.solve(1);
         assert_ne!(all.status, ConicStatus::Solved);
         assert_eq!(all.attempts, ATTEMPTS);
