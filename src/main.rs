@@ -153,8 +153,9 @@ enum Command {
         /// verdict ends undecided, and says so.
         #[arg(long, default_value_t = counterpoise_optimise::certify::DEFAULT_MAX_NODES as u64, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
         max_nodes: u64,
-        /// Seed of the local search's starting points (verdicts, optima and ranks do not
-        /// depend on it).
+        /// Seed of the local search's starting points. Verdicts do not depend on it, nor an
+        /// objective beyond its certified gap; a rank can move where a gap stays open or the
+        /// spring choice by ΔR (a local search, not certified) finds another option.
         #[arg(long, value_name = "N")]
         seed: Option<u64>,
         #[command(flatten)]
