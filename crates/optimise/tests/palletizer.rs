@@ -447,9 +447,7 @@ fn the_spring_realization_recovers_by_more_starts_and_by_moving_the_counterweigh
 /// box limit, with a design no worse than that one.
 #[test]
 fn a_hybrid_whose_relaxed_anchor_is_inside_its_floor_closes_its_gap() {
-    let mut json = common::case_json("palletizer.json");
-    json["balancing"]["dmax"] = serde_json::json!(3);
-    let model = common::model(&json);
+    let model = palletizer_dmax3();
     let (_, results) =
         common::optimise(&model, &[&["m3", "m5", "K42"]], &OptimiseOptions::default());
     let v = &results[0];
@@ -467,9 +465,7 @@ fn a_hybrid_whose_relaxed_anchor_is_inside_its_floor_closes_its_gap() {
 /// reach at least that, above the certified bound and balanced.
 #[test]
 fn a_hybrid_whose_boxes_propose_poor_designs_is_descended_to_a_better_one() {
-    let mut json = common::case_json("palletizer.json");
-    json["balancing"]["dmax"] = serde_json::json!(3);
-    let model = common::model(&json);
+    let model = palletizer_dmax3();
     let (_, results) = common::optimise(
         &model,
         &[&["m4", "K53", "K54"]],
@@ -484,6 +480,13 @@ fn a_hybrid_whose_boxes_propose_poor_designs_is_descended_to_a_better_one() {
     assert!(v.verification.as_ref().unwrap().passed);
 }
 
+/// The palletizer case at Dmax 3.
+fn palletizer_dmax3() -> counterpoise_model::Model {
+    let mut json = common::case_json("palletizer.json");
+    json["balancing"]["dmax"] = serde_json::json!(3);
+    common::model(&json)
+}
+
 /// A Dmax 3 variant of the palletizer, optimised with the default options: its result, its
 /// problem, the index of its spring `spring`, and the first box its search starts from.
 fn dmax3_variant(
@@ -495,10 +498,8 @@ fn dmax3_variant(
     usize,
     counterpoise_optimise::certify::node::NodeBox,
 ) {
-    use counterpoise_optimise::certify::{BranchOptions, DEFAULT_MAX_NODES, root_box};
-    let mut json = common::case_json("palletizer.json");
-    json["balancing"]["dmax"] = serde_json::json!(3);
-    let model = common::model(&json);
+    use counterpoise_optimise::certify::root_box;
+    let model = palletizer_dmax3();
     let (ctx, mut results) = common::optimise(&model, &[labels], &OptimiseOptions::default());
     let problem = variant_problem(&ctx, labels);
     let index = problem
@@ -506,12 +507,7 @@ fn dmax3_variant(
         .iter()
         .position(|s| s.label == spring)
         .unwrap();
-    let options = BranchOptions {
-        gap_tolerance: 1e-3,
-        max_nodes: DEFAULT_MAX_NODES,
-        solver_iterations: 200,
-    };
-    let root = root_box(&problem, &options).unwrap();
+    let root = root_box(&problem, &OptimiseOptions::default().branch_options()).unwrap();
     assert_eq!(results.len(), 1);
     (results.pop().unwrap(), problem, index, root)
 }
@@ -623,9 +619,7 @@ fn a_spring_that_carries_a_fixed_moment_bounds_its_anchor_through_the_lower_norm
 /// within 250 boxes.
 #[test]
 fn a_box_the_lagrange_cones_leave_undecided_is_bounded_without_them() {
-    let mut json = common::case_json("palletizer.json");
-    json["balancing"]["dmax"] = serde_json::json!(3);
-    let model = common::model(&json);
+    let model = palletizer_dmax3();
     let options = OptimiseOptions {
         max_nodes: 250,
         ..OptimiseOptions::default()

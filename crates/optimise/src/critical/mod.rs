@@ -389,11 +389,7 @@ fn step(
         Some((d, r)) => (Some(d), r),
         None => (None, None),
     };
-    let branch = BranchOptions {
-        gap_tolerance: options.gap_tolerance,
-        max_nodes: options.max_nodes,
-        solver_iterations: options.solver_iterations,
-    };
+    let branch = options.branch_options();
     let b = &ctx.basis.unbalanced;
     let (verdict, state) = branch_and_bound(
         problem,

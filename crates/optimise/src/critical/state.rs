@@ -45,6 +45,18 @@ pub(super) fn default_max_nodes() -> usize {
     OptimiseOptions::default().max_nodes
 }
 
+impl OptimiseOptions {
+    /// The certified search's settings ([`crate::certify::branch_and_bound`]) these options
+    /// give: their gap tolerance, box limit and clarabel iteration limit.
+    pub fn branch_options(&self) -> crate::certify::BranchOptions {
+        crate::certify::BranchOptions {
+            gap_tolerance: self.gap_tolerance,
+            max_nodes: self.max_nodes,
+            solver_iterations: self.solver_iterations,
+        }
+    }
+}
+
 impl Default for OptimiseOptions {
     fn default() -> Self {
         OptimiseOptions {

@@ -83,15 +83,6 @@ fn two_link_counterweights() -> (Model, Context, VariantResult) {
     (model, ctx, variant)
 }
 
-/// The certified search's settings of `options`, with `max_nodes` boxes.
-fn branch_options(options: &OptimiseOptions, max_nodes: usize) -> BranchOptions {
-    BranchOptions {
-        gap_tolerance: options.gap_tolerance,
-        max_nodes,
-        solver_iterations: options.solver_iterations,
-    }
-}
-
 /// The pendulum's variant m1 + K10 at Dmax 2: a counterweight of at most `max_mass` kg within
 /// 1 m (a cylinder when `cylinder`, else a point mass) and a spring K10 to the base of
 /// 1–100 N/m between anchors within 0.3 m and 0.2 m (at most 6 N·m of the rod's 9.81).
@@ -414,7 +405,10 @@ fn a_search_resumed_on_more_tasks_ends_where_a_fresh_one_does() {
     assert!(more.len() > few.len());
     let (few_tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &few);
     let (more_tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &more);
-    let branch = branch_options(&options, 2000);
+    let branch = BranchOptions {
+        max_nodes: 2000,
+        ..options.branch_options()
+    };
     let b = &ctx.basis.unbalanced;
     let search = |tasks: &[Arc<TaskTorques>], warm: Option<SearchState>| {
         branch_and_bound(problem, b, tasks, options.objective, &branch, None, warm).unwrap()
@@ -467,7 +461,10 @@ fn a_search_gives_the_same_bits_on_one_thread_and_on_two() {
     let problem = run.problem.as_ref().unwrap();
     let tasks: Vec<usize> = (0..ctx.tasks.len().min(6)).collect();
     let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &tasks);
-    let branch = branch_options(&options, 2000);
+    let branch = BranchOptions {
+        max_nodes: 2000,
+        ..options.branch_options()
+    };
     let b = &ctx.basis.unbalanced;
     let search_on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -523,7 +520,10 @@ fn a_search_without_a_design_has_four_times_the_box_budget() {
     let problem = run.problem.as_ref().unwrap();
     let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &[0, 1]);
     let search = |max_nodes: usize| {
-        let branch = branch_options(&options, max_nodes);
+        let branch = BranchOptions {
+            max_nodes,
+            ..options.branch_options()
+        };
         let b = &ctx.basis.unbalanced;
         branch_and_bound(problem, b, &tasks, options.objective, &branch, None, None)
             .unwrap()
@@ -712,7 +712,7 @@ fn boxes_solved_together_are_the_boxes_solved_alone() {
     let run = run_after_loop(&ctx, &balanced_variant(&model, &["m4", "K72"]), &options);
     let problem = run.problem.as_ref().unwrap();
     let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
-    let branch = branch_options(&options, options.max_nodes);
+    let branch = options.branch_options();
     let base = RelaxationBase::new(problem, &tasks, options.objective);
     let bases = Bases {
         first: &base,
