@@ -159,6 +159,19 @@ impl SearchState {
             .map(|l| l.1)
             .fold(f64::INFINITY, f64::min)
     }
+
+    /// A new search from this one's first box: the same root and Lagrange ranges (they come
+    /// from the bounds alone, so every search of the variant computes the same ones), the root
+    /// as the only box, unsolved. A search started from it solves the same boxes as one
+    /// started from nothing, without computing the first box again (about forty of clarabel's
+    /// solves on a three-element variant).
+    pub fn restart(&self) -> SearchState {
+        SearchState {
+            root: self.root.clone(),
+            leaves: vec![(self.root.clone(), f64::NEG_INFINITY)],
+            lagrange: self.lagrange.clone(),
+        }
+    }
 }
 
 /// The relaxations a search solves its boxes with: `first`, and where it is given, `fallback`
@@ -457,8 +470,25 @@ fn tighten(
     options: &BranchOptions,
 ) -> NodeBox {
     let coords = coordinates(problem);
+    // Every anchor component's interval needs its spring's stiffness range: kept while the
+    // box it was computed on is unchanged (the same two solves, not repeated).
+    // (the stiffness's column, the box, its range)
+    type Kept = Option<(usize, NodeBox, Option<[f64; 2]>)>;
+    let stiffness: std::cell::RefCell<Kept> = std::cell::RefCell::new(None);
     let range = |root: &NodeBox, column: usize| {
-        base.lifted_range(problem, Some(root), column, options.solver_iterations)
+        let is_stiffness = problem.springs.iter().any(|s| s.column == column);
+        if is_stiffness
+            && let Some((c, on, r)) = &*stiffness.borrow()
+            && *c == column
+            && on == root
+        {
+            return *r;
+        }
+        let r = base.lifted_range(problem, Some(root), column, options.solver_iterations);
+        if is_stiffness {
+            *stiffness.borrow_mut() = Some((column, root.clone(), r));
+        }
+        r
     };
     for (k, c) in coords.iter().enumerate() {
         let narrowed = match *c {

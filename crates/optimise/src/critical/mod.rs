@@ -435,7 +435,12 @@ fn step(
             lower_bound.max(lower)
         ))),
         Verdict::Impossible { nodes } => Err(Failure::Discard(impossibility_certificate(
-            ctx, problem, &tasks, &branch, nodes,
+            ctx,
+            problem,
+            &tasks,
+            &branch,
+            nodes,
+            search.as_ref().map(SearchState::restart),
         ))),
     }
 }
@@ -543,6 +548,7 @@ fn impossibility_certificate(
     tasks: &[std::sync::Arc<crate::torque::TaskTorques>],
     branch: &BranchOptions,
     nodes: usize,
+    first_box: Option<SearchState>,
 ) -> String {
     let b = &ctx.basis.unbalanced;
     let proof = format!(
@@ -567,8 +573,16 @@ fn impossibility_certificate(
         max_nodes: branch.max_nodes.min(CERTIFICATE_NODES),
         ..*branch
     };
-    match branch_and_bound(problem, b, &[], Objective::Minimax, &wording, None, None)
-        .map(|(verdict, _)| verdict)
+    match branch_and_bound(
+        problem,
+        b,
+        &[],
+        Objective::Minimax,
+        &wording,
+        None,
+        first_box,
+    )
+    .map(|(verdict, _)| verdict)
     {
         Ok(Verdict::Impossible { nodes: n }) => format!(
             "no parameters within the bounds balance this variant ({}); proved by splitting \

@@ -552,6 +552,47 @@ fn a_search_without_a_design_has_four_times_the_box_budget() {
     }
 }
 
+/// An impossibility certificate words itself with a bounds-only search that starts from the
+/// main search's first box (`SearchState::restart`) instead of computing it again: that search
+/// must be the one a search from nothing makes, box for box. Checked on the impossible
+/// pendulum (bounds-only: impossible, with the same number of boxes) and on the feasible
+/// hybrid (bounds-only: optimal, the same design, bound and boxes), each restarted from a
+/// search on the tasks.
+#[test]
+fn a_search_restarted_from_another_first_box_is_the_search_from_nothing() {
+    for (cw_mass, cylinder, feasible) in [(0.1, false, false), (5.0, true, true)] {
+        let (_, ctx, variant) = pendulum_m1_k10(cw_mass, cylinder);
+        let options = OptimiseOptions::default();
+        let run = new_run(&ctx, &variant, &options);
+        let problem = run.problem.as_ref().unwrap();
+        let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &[0, 1]);
+        let branch = options.branch_options();
+        let b = &ctx.basis.unbalanced;
+        let (_, state) =
+            branch_and_bound(problem, b, &tasks, options.objective, &branch, None, None).unwrap();
+        let wording = |warm: Option<SearchState>| {
+            branch_and_bound(problem, b, &[], Objective::Minimax, &branch, None, warm)
+                .unwrap()
+                .0
+        };
+        let fresh = wording(None);
+        let restarted = wording(Some(state.restart()));
+        // The debug text prints every float exactly (shortest round trip).
+        assert_eq!(
+            format!("{fresh:?}"),
+            format!("{restarted:?}"),
+            "m1 at most {cw_mass} kg"
+        );
+        let (nodes, found) = match fresh {
+            Verdict::Impossible { nodes } => (nodes, false),
+            Verdict::Optimal { nodes, .. } => (nodes, true),
+            Verdict::Stopped { design, nodes, .. } => (nodes, design.is_some()),
+        };
+        assert_eq!(found, feasible, "m1 at most {cw_mass} kg");
+        assert!(nodes >= 1);
+    }
+}
+
 /// The spring choice evaluates every run's options in one pass over the union of the runs'
 /// tasks. Each group must get exactly (bit for bit) what it gets evaluated on its own, over
 /// its own tasks only: groups here differ in their spring slots (to the base and between
@@ -691,6 +732,59 @@ fn an_anchor_interval_is_the_quotient_of_the_lifted_ranges() {
     let mut almost = pinned.clone();
     almost.particular[lifted] = 1e-300;
     assert_eq!(anchor_range(&almost, &root, 0, 1, &asked), Some([1.0, 1.0]));
+}
+
+/// The first box keeps each spring's stiffness range while the box it was computed on is
+/// unchanged (`certify::tighten`): the box must be the one each anchor component's interval
+/// gives with every range solved afresh. On the palletizer's m4 + K42 + K64 (two springs, seven
+/// anchor components, a counterweight), checked against that computation done here.
+#[test]
+fn the_first_box_is_the_same_with_every_range_solved_afresh() {
+    use crate::certify::node::{Coordinate, NodeBox, coordinates};
+    use crate::certify::{anchor_range, root_box};
+    use crate::relaxation::RelaxationBase;
+    let mut json = case_json("palletizer.json");
+    json["balancing"]["dmax"] = serde_json::json!(3);
+    let model = model(&json);
+    let ctx = Context::new(&model, None).unwrap();
+    let pendulum = pendulum_m1_k10(0.5, false);
+    let options = OptimiseOptions::default();
+    for (ctx, variant) in [
+        (&ctx, balanced_variant(&model, &["m4", "K42", "K64"])),
+        (&pendulum.1, pendulum.2.clone()),
+    ] {
+        let run = new_run(ctx, &variant, &options);
+        let problem = run.problem.as_ref().unwrap();
+        let branch = options.branch_options();
+        let base = RelaxationBase::new(problem, &[], Objective::Minimax);
+        let range = |node: &NodeBox, column: usize| {
+            base.lifted_range(problem, Some(node), column, branch.solver_iterations)
+        };
+        let wide = NodeBox::root(problem).unwrap();
+        let mut expected = wide.clone();
+        for (k, c) in coordinates(problem).into_iter().enumerate() {
+            let narrowed = match c {
+                Coordinate::Mass { cw } => range(&expected, problem.counterweights[cw].column),
+                Coordinate::Moment { cw, k } => {
+                    range(&expected, problem.counterweights[cw].column + 1 + k)
+                }
+                Coordinate::AnchorA { spring, i } => {
+                    anchor_range(problem, &expected, spring, 1 + i, &range)
+                }
+                Coordinate::AnchorB { spring, l } => {
+                    let na = problem.springs[spring].axes_a.len();
+                    anchor_range(problem, &expected, spring, 1 + na + l, &range)
+                }
+            };
+            let [lo, hi] = narrowed.expect("every range is solved");
+            assert!(lo <= hi, "coordinate {k}: [{lo}, {hi}]");
+            let r = &mut expected.ranges[k];
+            r[0] = r[0].max(lo);
+            r[1] = r[1].min(hi).max(r[0]);
+        }
+        assert_ne!(expected, wide, "the bounds must narrow some coordinate");
+        assert_eq!(root_box(problem, &branch).unwrap(), expected);
+    }
 }
 
 /// The children of a split solved together (`certify::bound_boxes`) give each child the bound
