@@ -192,6 +192,22 @@ pub(crate) struct Bases<'a> {
     pub(crate) fallback: Option<&'a RelaxationBase>,
 }
 
+/// The relaxations of a search ([`Bases`]) from the relaxation without the Lagrange cones
+/// and with them: where the cones add rows, they with two of clarabel's runs and the one
+/// without them as the fallback, also with two; where they add none (no spring has a lower
+/// anchor norm bound, or no cone can cut), that relaxation alone with all of clarabel's runs
+/// (a fallback identical to it would only repeat its first two runs).
+pub(crate) fn search_relaxations(
+    plain: RelaxationBase,
+    with_cones: RelaxationBase,
+) -> (RelaxationBase, Option<RelaxationBase>) {
+    if with_cones.rows() > plain.rows() {
+        (with_cones.limit_attempts(2), Some(plain.limit_attempts(2)))
+    } else {
+        (with_cones, None)
+    }
+}
+
 /// Solves the relaxation on `node`; `None` when the box is proved to hold no point (the
 /// relaxation is infeasible, or an anchor's lower norm bound excludes the whole box).
 pub(crate) fn bound_box(
@@ -470,24 +486,21 @@ fn tighten(
     options: &BranchOptions,
 ) -> NodeBox {
     let coords = coordinates(problem);
-    // Every anchor component's interval needs its spring's stiffness range: kept while the
-    // box it was computed on is unchanged (the same two solves, not repeated).
-    // (the stiffness's column, the box, its range)
-    type Kept = Option<(usize, NodeBox, Option<[f64; 2]>)>;
-    let stiffness: std::cell::RefCell<Kept> = std::cell::RefCell::new(None);
+    // Every anchor component's interval needs its spring's stiffness range: each range solved
+    // is kept, per column, while the box it was solved on is unchanged (the same two solves,
+    // not repeated).
+    type Solved = Vec<(usize, NodeBox, Option<[f64; 2]>)>; // (column, box, range)
+    let solved: std::cell::RefCell<Solved> = std::cell::RefCell::new(Vec::new());
     let range = |root: &NodeBox, column: usize| {
-        let is_stiffness = problem.springs.iter().any(|s| s.column == column);
-        if is_stiffness
-            && let Some((c, on, r)) = &*stiffness.borrow()
-            && *c == column
+        let mut solved = solved.borrow_mut();
+        if let Some((_, on, r)) = solved.iter().find(|(c, _, _)| *c == column)
             && on == root
         {
             return *r;
         }
         let r = base.lifted_range(problem, Some(root), column, options.solver_iterations);
-        if is_stiffness {
-            *stiffness.borrow_mut() = Some((column, root.clone(), r));
-        }
+        solved.retain(|(c, _, _)| *c != column);
+        solved.push((column, root.clone(), r));
         r
     };
     for (k, c) in coords.iter().enumerate() {
@@ -590,12 +603,8 @@ pub fn branch_and_bound(
         }
     };
     let plain = RelaxationBase::new(problem, tasks, objective);
-    let base = plain.clone().with_lagrange_bounds(problem, &lagrange);
-    let (base, fallback) = if base.rows() > plain.rows() {
-        (base.limit_attempts(2), Some(plain.limit_attempts(2)))
-    } else {
-        (base, None)
-    };
+    let with_cones = plain.clone().with_lagrange_bounds(problem, &lagrange);
+    let (base, fallback) = search_relaxations(plain, with_cones);
     let bases = Bases {
         first: &base,
         fallback: fallback.as_ref(),
@@ -794,7 +803,7 @@ pub fn branch_and_bound(
             .iter()
             .flat_map(|&k| current.node.split(k))
             .enumerate()
-            .map(|(n, child)| (child, order + 1 + n % 2))
+            .map(|(n, child)| (child, child_order(order, n)))
             .collect();
         nodes += boxes.len();
         let mut solved = bound_boxes(problem, &bases, &mut active, options, boxes, current.bound);
@@ -829,6 +838,16 @@ pub fn branch_and_bound(
     }
 }
 
+/// The order of the `n`-th child box of a split made when the orders given so far end at
+/// `order` (each split takes two: the loop adds 2 after it). Every child is newer than every
+/// box before the split, so that among tied bounds the search dives into the boxes it just
+/// made; within a split the upper half (`n` odd) is newer than the lower. The children of
+/// strong branching's alternative split (`n` = 2, 3) take the same two orders as the first
+/// pair: only one pair is kept.
+fn child_order(order: usize, n: usize) -> usize {
+    order + 1 + n % 2
+}
+
 /// The bounds a design must meet, in words, for a certificate: each spring's stiffness and
 /// anchor ranges, each counterweight's mass and offset ranges.
 pub fn bounds_in_words(problem: &VariantProblem) -> String {
@@ -861,4 +880,23 @@ pub fn bounds_in_words(problem: &VariantProblem) -> String {
         ));
     }
     parts.join("; ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::child_order;
+
+    /// The search picks the newest of the boxes whose bounds tie: a split's children must be
+    /// newer than every box before it, the upper half newer than the lower, the alternative
+    /// pair numbered as the first, and the next split's children newer than this one's.
+    #[test]
+    fn children_are_numbered_after_every_box_before_them() {
+        for order in [0, 1, 2, 7, 400] {
+            let c: Vec<usize> = (0..4).map(|n| child_order(order, n)).collect();
+            assert!(c[0] > order, "order {order}: {c:?}");
+            assert!(c[1] > c[0], "order {order}: {c:?}");
+            assert_eq!((c[2], c[3]), (c[0], c[1]), "order {order}");
+            assert!(child_order(order + 2, 0) > c[1], "order {order}: {c:?}");
+        }
+    }
 }

@@ -787,6 +787,50 @@ fn the_first_box_is_the_same_with_every_range_solved_afresh() {
     }
 }
 
+/// A search falls back to the relaxation without the Lagrange cones only where the cones add
+/// rows: the pendulum's spring K10 has no lower anchor norm bound (its anchors may reach the
+/// pivot), so its cones add none and the search keeps one relaxation; the palletizer's springs
+/// have one (anchors at least the case's minimum length from the joint), and on m5 + K52 + K53
+/// (a Dmax 3 variant whose boxes the cones left undecided) they cut, so it gets the cones first
+/// and the plain relaxation as the fallback.
+#[test]
+fn the_fallback_relaxation_is_kept_only_where_the_cones_add_rows() {
+    use crate::certify::{root_box, search_relaxations};
+    use crate::relaxation::RelaxationBase;
+    let (_, pendulum, m1_k10) = pendulum_m1_k10(5.0, true);
+    let mut json = case_json("palletizer.json");
+    json["balancing"]["dmax"] = serde_json::json!(3);
+    let palletizer_model = model(&json);
+    let palletizer = Context::new(&palletizer_model, None).unwrap();
+    let m5_k52_k53 = balanced_variant(&palletizer_model, &["m5", "K52", "K53"]);
+    let options = OptimiseOptions::default();
+    let branch = options.branch_options();
+    for (ctx, variant, floors) in [(&pendulum, m1_k10, false), (&palletizer, m5_k52_k53, true)] {
+        let run = new_run(ctx, &variant, &options);
+        let problem = run.problem.as_ref().unwrap();
+        let has_floor = problem
+            .springs
+            .iter()
+            .any(|s| s.bounds.anchor_a[0] > 0.0 || s.bounds.anchor_b[0] > 0.0);
+        assert_eq!(has_floor, floors);
+        let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &[0, 1]);
+        let plain = RelaxationBase::new(problem, &tasks, options.objective);
+        let root = root_box(problem, &branch).unwrap();
+        let bounds_only = RelaxationBase::new(problem, &[], Objective::Minimax);
+        let lagrange = bounds_only.lagrange_ranges(problem, Some(&root), branch.solver_iterations);
+        let with_cones = plain.clone().with_lagrange_bounds(problem, &lagrange);
+        let (plain_rows, cone_rows) = (plain.rows(), with_cones.rows());
+        assert_eq!(
+            cone_rows > plain_rows,
+            floors,
+            "{cone_rows} against {plain_rows} rows"
+        );
+        let (first, fallback) = search_relaxations(plain, with_cones);
+        assert_eq!(first.rows(), cone_rows);
+        assert_eq!(fallback.map(|f| f.rows()), floors.then_some(plain_rows));
+    }
+}
+
 /// The children of a split solved together (`certify::bound_boxes`) give each child the bound
 /// and relaxed point it has solved alone from the same peak rows, and leave marked every peak
 /// row any child used: the union of the rows each child, solved alone, reports. On the
