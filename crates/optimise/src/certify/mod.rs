@@ -468,6 +468,37 @@ fn branching_coordinate(
     }
 }
 
+/// The lifted ranges solved while the first box narrows, each kept with the box it was
+/// solved on: a range asked for again on the same box is not solved again. Each anchor
+/// component's interval is a quotient by its spring's stiffness range, so without this the
+/// stiffness's two solves were repeated for every component.
+#[derive(Default)]
+struct KeptRanges {
+    /// (column, box, range), at most one per column: the latest.
+    kept: Vec<(usize, NodeBox, Option<[f64; 2]>)>,
+}
+
+impl KeptRanges {
+    /// The range of `column` on `node`: the kept one if it was solved on this box, otherwise
+    /// `solve()`, which is then kept in place of the column's older one.
+    fn range(
+        &mut self,
+        column: usize,
+        node: &NodeBox,
+        solve: impl FnOnce() -> Option<[f64; 2]>,
+    ) -> Option<[f64; 2]> {
+        if let Some((_, on, r)) = self.kept.iter().find(|(c, _, _)| *c == column)
+            && on == node
+        {
+            return *r;
+        }
+        let r = solve();
+        self.kept.retain(|(c, _, _)| *c != column);
+        self.kept.push((column, node.clone(), r));
+        r
+    }
+}
+
 /// The root box narrowed to what the bounds-only relaxation allows (its ranges hold every
 /// physical point, so the box keeps every design):
 ///
@@ -486,22 +517,12 @@ fn tighten(
     options: &BranchOptions,
 ) -> NodeBox {
     let coords = coordinates(problem);
-    // Every anchor component's interval needs its spring's stiffness range: each range solved
-    // is kept, per column, while the box it was solved on is unchanged (the same two solves,
-    // not repeated).
-    type Solved = Vec<(usize, NodeBox, Option<[f64; 2]>)>; // (column, box, range)
-    let solved: std::cell::RefCell<Solved> = std::cell::RefCell::new(Vec::new());
+    // Every anchor component's interval needs its spring's stiffness range (see `KeptRanges`).
+    let kept = std::cell::RefCell::new(KeptRanges::default());
     let range = |root: &NodeBox, column: usize| {
-        let mut solved = solved.borrow_mut();
-        if let Some((_, on, r)) = solved.iter().find(|(c, _, _)| *c == column)
-            && on == root
-        {
-            return *r;
-        }
-        let r = base.lifted_range(problem, Some(root), column, options.solver_iterations);
-        solved.retain(|(c, _, _)| *c != column);
-        solved.push((column, root.clone(), r));
-        r
+        kept.borrow_mut().range(column, root, || {
+            base.lifted_range(problem, Some(root), column, options.solver_iterations)
+        })
     };
     for (k, c) in coords.iter().enumerate() {
         let narrowed = match *c {
@@ -884,7 +905,49 @@ pub fn bounds_in_words(problem: &VariantProblem) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::child_order;
+    use super::{KeptRanges, NodeBox, child_order};
+
+    /// A range is solved again exactly when its column was not solved on this box: counted
+    /// by hand over a sequence of requests on two boxes and three columns.
+    #[test]
+    fn a_kept_range_is_reused_only_on_the_box_it_was_solved_on() {
+        let wide = NodeBox {
+            ranges: vec![[-1.0, 1.0], [0.0, 2.0]],
+        };
+        let narrow = NodeBox {
+            ranges: vec![[-0.5, 1.0], [0.0, 2.0]],
+        };
+        let mut kept = KeptRanges::default();
+        let mut solves = 0;
+        // (column, box, solved now?, the range a solve gives)
+        let requests = [
+            (3, &wide, true, 1.0),
+            (3, &wide, false, 2.0),
+            (5, &wide, true, 3.0),
+            (3, &wide, false, 4.0),
+            (3, &narrow, true, 5.0),
+            (3, &narrow, false, 6.0),
+            (5, &wide, false, 7.0),
+            (5, &narrow, true, 8.0),
+            (3, &wide, true, 9.0),
+            (7, &narrow, true, 10.0),
+            (3, &wide, false, 11.0),
+        ];
+        let mut latest = std::collections::BTreeMap::new();
+        for (n, &(column, node, fresh, value)) in requests.iter().enumerate() {
+            let before = solves;
+            let r = kept.range(column, node, || {
+                solves += 1;
+                Some([value, value])
+            });
+            assert_eq!(solves > before, fresh, "request {n}");
+            if fresh {
+                latest.insert(column, value);
+            }
+            assert_eq!(r, Some([latest[&column]; 2]), "request {n}");
+        }
+        assert_eq!(solves, 6);
+    }
 
     /// The search picks the newest of the boxes whose bounds tie: a split's children must be
     /// newer than every box before it, the upper half newer than the lower, the alternative
