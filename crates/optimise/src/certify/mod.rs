@@ -557,7 +557,7 @@ pub fn root_box(problem: &VariantProblem, options: &BranchOptions) -> Result<Nod
 
 /// The first box ([`root_box`]) and each spring's Lagrange ranges over it
 /// ([`RelaxationBase::lagrange_ranges`]), both from one bounds-only relaxation.
-fn first_box(
+pub(crate) fn first_box(
     problem: &VariantProblem,
     options: &BranchOptions,
 ) -> Result<(NodeBox, LagrangeRanges), String> {

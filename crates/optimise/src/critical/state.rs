@@ -31,8 +31,9 @@ pub struct OptimiseOptions {
     pub max_nodes: usize,
     /// Seed of the local search's starting points after the first. Verdicts do not depend on
     /// it, nor an objective beyond its certified gap; ranks can move where a gap stays open or
-    /// the spring choice by ΔR (a local search among the seeded starts) finds another option
-    /// (at Dmax 3 on the palletizer, 60 of 788 rank numbers between two seeds).
+    /// another design within the gap gives the spring choice by ΔR (a local search, not
+    /// certified) other options (at Dmax 3 on the palletizer, 60 of 788 rank numbers between
+    /// two seeds).
     #[serde(default = "default_start_seed")]
     pub start_seed: u64,
 }

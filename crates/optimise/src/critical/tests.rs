@@ -53,6 +53,13 @@ fn balanced_variant(model: &Model, labels: &[&str]) -> VariantResult {
         .unwrap_or_else(|| panic!("{labels:?} is not a balanced variant"))
 }
 
+/// The palletizer case at Dmax 3.
+fn palletizer_dmax3() -> Model {
+    let mut json = case_json("palletizer.json");
+    json["balancing"]["dmax"] = serde_json::json!(3);
+    model(&json)
+}
+
 /// The run of one variant after the critical-task loop (before the spring choice).
 fn run_after_loop(ctx: &Context, variant: &VariantResult, options: &OptimiseOptions) -> Run {
     let mut runs = vec![new_run(ctx, variant, options)];
@@ -734,18 +741,17 @@ fn an_anchor_interval_is_the_quotient_of_the_lifted_ranges() {
     assert_eq!(anchor_range(&almost, &root, 0, 1, &asked), Some([1.0, 1.0]));
 }
 
-/// The first box keeps each spring's stiffness range while the box it was computed on is
-/// unchanged (`certify::tighten`): the box must be the one each anchor component's interval
-/// gives with every range solved afresh. On the palletizer's m4 + K42 + K64 (two springs, seven
-/// anchor components, a counterweight), checked against that computation done here.
+/// The first box keeps each range it solves while the box it was solved on is unchanged
+/// (`certify::KeptRanges`): the box must be the one each anchor component's interval gives
+/// with every range solved afresh. On the palletizer's m4 + K42 + K64 (two springs, seven
+/// anchor components, a counterweight) and the pendulum's m1 + K10, checked against that
+/// computation done here.
 #[test]
 fn the_first_box_is_the_same_with_every_range_solved_afresh() {
     use crate::certify::node::{Coordinate, NodeBox, coordinates};
     use crate::certify::{anchor_range, root_box};
     use crate::relaxation::RelaxationBase;
-    let mut json = case_json("palletizer.json");
-    json["balancing"]["dmax"] = serde_json::json!(3);
-    let model = model(&json);
+    let model = palletizer_dmax3();
     let ctx = Context::new(&model, None).unwrap();
     let pendulum = pendulum_m1_k10(0.5, false);
     let options = OptimiseOptions::default();
@@ -795,12 +801,10 @@ fn the_first_box_is_the_same_with_every_range_solved_afresh() {
 /// and the plain relaxation as the fallback.
 #[test]
 fn the_fallback_relaxation_is_kept_only_where_the_cones_add_rows() {
-    use crate::certify::{root_box, search_relaxations};
+    use crate::certify::{first_box, search_relaxations};
     use crate::relaxation::RelaxationBase;
     let (_, pendulum, m1_k10) = pendulum_m1_k10(5.0, true);
-    let mut json = case_json("palletizer.json");
-    json["balancing"]["dmax"] = serde_json::json!(3);
-    let palletizer_model = model(&json);
+    let palletizer_model = palletizer_dmax3();
     let palletizer = Context::new(&palletizer_model, None).unwrap();
     let m5_k52_k53 = balanced_variant(&palletizer_model, &["m5", "K52", "K53"]);
     let options = OptimiseOptions::default();
@@ -815,9 +819,7 @@ fn the_fallback_relaxation_is_kept_only_where_the_cones_add_rows() {
         assert_eq!(has_floor, floors);
         let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &[0, 1]);
         let plain = RelaxationBase::new(problem, &tasks, options.objective);
-        let root = root_box(problem, &branch).unwrap();
-        let bounds_only = RelaxationBase::new(problem, &[], Objective::Minimax);
-        let lagrange = bounds_only.lagrange_ranges(problem, Some(&root), branch.solver_iterations);
+        let (_, lagrange) = first_box(problem, &branch).unwrap();
         let with_cones = plain.clone().with_lagrange_bounds(problem, &lagrange);
         let (plain_rows, cone_rows) = (plain.rows(), with_cones.rows());
         assert_eq!(
