@@ -27,8 +27,8 @@ use variants::balanced;
 
 use counterpoise_dynamics::params::ParameterSet;
 use counterpoise_dynamics::{
-    Combination, Counterweight, EvaluateOptions, Spring, Variant, evaluate_grid_indicators,
-    evaluate_grid_indicators_with,
+    Combination, Counterweight, EvaluateOptions, Spring, Variant, evaluate_grid_indicators_with,
+    evaluate_unbalanced_grid,
 };
 use counterpoise_model::{Case, Model};
 use counterpoise_optimise::{Context, OptimiseOptions, OptimisedVariant, optimise_all};
@@ -41,12 +41,7 @@ fn palletizer() -> Model {
 
 /// Phase 1, the search and the optimisation, as `run` chains them.
 fn study(model: &Model, dmax: usize) -> Vec<OptimisedVariant> {
-    let mut ub = evaluate_grid_indicators(
-        model,
-        &ParameterSet::unbalanced(model),
-        &EvaluateOptions::default(),
-    )
-    .expect("phase 1");
+    let mut ub = evaluate_unbalanced_grid(model, &EvaluateOptions::default()).expect("phase 1");
     let variants = balanced(model, dmax);
     let ctx = Context::new(model, Some(ub.indicators.swap_remove(0))).expect("context");
     optimise_all(&ctx, &variants, &OptimiseOptions::default())
@@ -124,9 +119,8 @@ fn pipeline(c: &mut Criterion) {
     group.sample_size(10);
     group.warm_up_time(Duration::from_secs(1));
     group.measurement_time(Duration::from_secs(15));
-    let ub = ParameterSet::unbalanced(&model);
     group.bench_function("unbalanced_reactions", |b| {
-        b.iter(|| evaluate_grid_indicators(&model, &ub, &EvaluateOptions::default()))
+        b.iter(|| evaluate_unbalanced_grid(&model, &EvaluateOptions::default()))
     });
     group.finish();
 

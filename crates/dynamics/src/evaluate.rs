@@ -154,14 +154,29 @@ pub fn evaluate_grid(
     params: &ParameterSet,
     options: &EvaluateOptions,
 ) -> Result<GridEvaluation, DynamicsError> {
-    evaluate_grid_reporting(model, params, options, &silent)
+    evaluate_grid_reporting(model, params, options, Combination::Direct, &silent)
 }
 
-/// [`evaluate_grid`] that reports the units of work done to `progress`.
+/// [`evaluate_grid`] of the model's own parameters (the unbalanced robot, Phase 1), its
+/// reactions by substitution ([`Combination::Substitution`]: a one-column batch does not pay
+/// for the reaction operator). Every unbalanced evaluation goes through here, so the
+/// unbalanced figures are the same bits in `evaluate`, a study's Phase 1 and a context built
+/// without them.
+pub fn evaluate_unbalanced_grid(
+    model: &Model,
+    options: &EvaluateOptions,
+) -> Result<GridEvaluation, DynamicsError> {
+    let params = ParameterSet::unbalanced(model);
+    evaluate_grid_reporting(model, &params, options, Combination::Substitution, &silent)
+}
+
+/// [`evaluate_grid`] with the columns combined as `combination` says, reporting the units of
+/// work done to `progress`.
 fn evaluate_grid_reporting(
     model: &Model,
     params: &ParameterSet,
     options: &EvaluateOptions,
+    combination: Combination,
     progress: GridProgress,
 ) -> Result<GridEvaluation, DynamicsError> {
     let (tasks, ev, cyclic) = grid_setup(model, params, options)?;
@@ -178,7 +193,7 @@ fn evaluate_grid_reporting(
             &tasks,
             params,
             options.reactions,
-            Combination::Direct,
+            combination,
             crate::fast::GridSink::Table(&mut table),
             progress,
         ),
@@ -260,7 +275,7 @@ pub fn evaluate_grid_indicators_reporting(
 ) -> Result<GridIndicators, DynamicsError> {
     let (tasks, ev, cyclic) = grid_setup(model, params, options)?;
     let Some(cyc) = cyclic else {
-        let grid = evaluate_grid_reporting(model, params, options, progress)?;
+        let grid = evaluate_grid_reporting(model, params, options, combination, progress)?;
         return Ok(GridIndicators {
             indicators: grid.indicators,
             excluded: grid.excluded,
@@ -342,8 +357,7 @@ pub fn evaluate(
     model: &Model,
     options: &EvaluateOptions,
 ) -> Result<EvaluationReport, DynamicsError> {
-    let params = ParameterSet::unbalanced(model);
-    let mut grid = evaluate_grid(model, &params, options)?;
+    let mut grid = evaluate_unbalanced_grid(model, options)?;
     let tasks = &grid.tasks;
     Ok(EvaluationReport {
         case: model.name.clone(),

@@ -262,6 +262,7 @@ pub(crate) fn evaluate_cyclic(
                 params,
                 &groups,
                 superposition.as_ref(),
+                combination == Combination::Substitution,
                 with_reactions,
                 per_sample_stride,
                 work,
@@ -531,6 +532,7 @@ fn sub_task(
     params: &ParameterSet,
     groups: &InertiaGroups,
     superposition: Option<&Superposition>,
+    substitute: bool,
     with_reactions: bool,
     stride: usize,
     work: &mut Work,
@@ -593,7 +595,9 @@ fn sub_task(
         if with_reactions {
             ev.reactions
                 .prepare(mech, &pose, &work.kin, &lu, &mut work.reactions_work);
-            ev.reactions.prepare_operator(&mut work.reactions_work);
+            if !substitute {
+                ev.reactions.prepare_operator(&mut work.reactions_work);
+            }
         }
         for (si, d) in [0.0, 1.0, -1.0].into_iter().enumerate() {
             let mut qd = ud;
@@ -688,16 +692,22 @@ fn sub_task(
                 }
             }
             let ops = &ev.reactions;
-            let (b, out) = (&work.b, &mut work.out);
-            ops.apply_operator(&work.reactions_work, b, solved, cols, out);
-            let pm = cols + nreps;
-            ops.apply_operator(
-                &work.reactions_work,
-                &b[pm..],
-                solved,
-                2 * nreps,
-                &mut out[pm..],
-            );
+            if substitute {
+                // Every right-hand side by substitution (the representatives' at Δ = 0 too,
+                // whose reactions are not read).
+                ops.solve_prepared(&mut work.reactions_work, &mut work.b, solved, &mut work.out);
+            } else {
+                let (b, out) = (&work.b, &mut work.out);
+                ops.apply_operator(&work.reactions_work, b, solved, cols, out);
+                let pm = cols + nreps;
+                ops.apply_operator(
+                    &work.reactions_work,
+                    &b[pm..],
+                    solved,
+                    2 * nreps,
+                    &mut out[pm..],
+                );
+            }
         }
         work.scratch.pose = pose;
         // Every (evaluated) column at Δ = ±1 from its representative:

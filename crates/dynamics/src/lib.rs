@@ -38,8 +38,8 @@ pub use error::{DynamicsError, FailureReason, TaskFailure};
 pub use evaluate::{
     Combination, EvaluateOptions, EvaluationReport, Excluded, GridEvaluation, GridIndicators,
     JointSeries, Series, evaluate, evaluate_grid, evaluate_grid_indicators,
-    evaluate_grid_indicators_reporting, evaluate_grid_indicators_with, task_series,
-    task_series_with,
+    evaluate_grid_indicators_reporting, evaluate_grid_indicators_with, evaluate_unbalanced_grid,
+    task_series, task_series_with,
 };
 pub use indicators::{ActuatorIndicators, Indicators, JointIndicators, TaskStats};
 pub use params::{Counterweight, ParameterSet, Spring, SpringSlot, Variant};

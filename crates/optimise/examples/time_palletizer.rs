@@ -16,8 +16,7 @@ use counterpoise_balance::{
     Catalogue, SearchOptions, Status, catalogue_options, mechanism_energy, realization_hints,
     search,
 };
-use counterpoise_dynamics::params::ParameterSet;
-use counterpoise_dynamics::{EvaluateOptions, evaluate_grid};
+use counterpoise_dynamics::{EvaluateOptions, evaluate_unbalanced_grid};
 use counterpoise_model::Case;
 use counterpoise_optimise::{Context, OptimiseOptions, optimise_all};
 
@@ -54,12 +53,7 @@ fn main() {
         .cloned()
         .collect();
     let t0 = Instant::now();
-    let mut ub = evaluate_grid(
-        &model,
-        &ParameterSet::unbalanced(&model),
-        &EvaluateOptions::default(),
-    )
-    .unwrap();
+    let mut ub = evaluate_unbalanced_grid(&model, &EvaluateOptions::default()).unwrap();
     let phase1 = t0.elapsed().as_secs_f64();
     let ub = ub.indicators.swap_remove(0);
     eprintln!(

@@ -14,8 +14,7 @@ use counterpoise_balance::{
     Catalogue, SearchOptions, Status, catalogue_options, mechanism_energy, realization_hints,
     search,
 };
-use counterpoise_dynamics::params::ParameterSet;
-use counterpoise_dynamics::{EvaluateOptions, evaluate_grid};
+use counterpoise_dynamics::{EvaluateOptions, evaluate_unbalanced_grid};
 use counterpoise_model::Case;
 use counterpoise_optimise::{Context, OptimiseOptions, StageTime, Stopwatch, optimise_all_timed};
 
@@ -56,12 +55,8 @@ fn main() {
     for run in 0..runs {
         let start = Stopwatch::start();
         let t = Stopwatch::start();
-        let mut ub = evaluate_grid(
-            &model,
-            &ParameterSet::unbalanced(&model),
-            &EvaluateOptions::default(),
-        )
-        .expect("phase 1");
+        let mut ub =
+            evaluate_unbalanced_grid(&model, &EvaluateOptions::default()).expect("phase 1");
         let phase1 = t.elapsed();
         let t = Stopwatch::start();
         let energy = mechanism_energy(&model);

@@ -6,8 +6,7 @@ use counterpoise_balance::linear::LiftedBasis;
 use counterpoise_balance::{
     Catalogue, Element, MechanismEnergy, VerificationSet, catalogue_options, mechanism_energy,
 };
-use counterpoise_dynamics::params::ParameterSet;
-use counterpoise_dynamics::{EvaluateOptions, Indicators, TaskSet, evaluate_grid};
+use counterpoise_dynamics::{EvaluateOptions, Indicators, TaskSet, evaluate_unbalanced_grid};
 use counterpoise_model::Model;
 
 use crate::error::OptimiseError;
@@ -55,7 +54,7 @@ impl Context {
                 let mut options = EvaluateOptions::default();
                 options.samples = None;
                 options.reactions = true;
-                let mut grid = evaluate_grid(model, &ParameterSet::unbalanced(model), &options)?;
+                let mut grid = evaluate_unbalanced_grid(model, &options)?;
                 grid.indicators.swap_remove(0)
             }
         };

@@ -15,8 +15,7 @@ use counterpoise_balance::{
     Catalogue, SearchOptions, SearchReport, Status, VariantResult, catalogue_options,
     mechanism_energy, realization_hints, search,
 };
-use counterpoise_dynamics::params::ParameterSet;
-use counterpoise_dynamics::{EvaluateOptions, Indicators, evaluate_grid};
+use counterpoise_dynamics::{EvaluateOptions, Indicators, evaluate_unbalanced_grid};
 use counterpoise_model::{Model, ModelError};
 use counterpoise_optimise::{Context, Objective, OptimiseOptions, optimise_all_reporting};
 use counterpoise_report as report;
@@ -292,11 +291,7 @@ impl<'m> Study<'m> {
         let model = self.model;
         let (unbalanced, grid_info) =
             timer.time("Phase 1: unbalanced robot over all tasks", || {
-                let grid = evaluate_grid(
-                    model,
-                    &ParameterSet::unbalanced(model),
-                    &EvaluateOptions::default(),
-                )?;
+                let grid = evaluate_unbalanced_grid(model, &EvaluateOptions::default())?;
                 let info = (
                     grid.tasks.len(),
                     grid.excluded.count,
