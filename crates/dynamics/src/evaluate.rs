@@ -159,9 +159,9 @@ pub fn evaluate_grid(
 
 /// [`evaluate_grid`] of the model's own parameters (the unbalanced robot, Phase 1), its
 /// reactions by substitution ([`Combination::Substitution`]: a one-column batch does not pay
-/// for the reaction operator). Every unbalanced evaluation goes through here, so the
-/// unbalanced figures are the same bits in `evaluate`, a study's Phase 1 and a context built
-/// without them.
+/// for the reaction operator). Every grid evaluation of the unbalanced robot goes through
+/// here (`evaluate`, a study's Phase 1 and its reach check, a context built without Phase 1's
+/// figures), so the unbalanced figures are the same bits in all of them.
 pub fn evaluate_unbalanced_grid(
     model: &Model,
     options: &EvaluateOptions,

@@ -7,7 +7,9 @@ use std::sync::OnceLock;
 
 use counterpoise_balance::enumerate::variant_count;
 use counterpoise_balance::{Catalogue, catalogue_options, mechanism_energy};
-use counterpoise_dynamics::{EvaluateOptions, Evaluator, ParameterSet, evaluate_grid, path_series};
+use counterpoise_dynamics::{
+    EvaluateOptions, Evaluator, ParameterSet, evaluate_unbalanced_grid, path_series,
+};
 use counterpoise_model::limits::{Limit, Limits, format_count};
 use counterpoise_model::{Model, ModelError};
 
@@ -196,7 +198,7 @@ pub fn grid_reach(model: &Model) -> Result<Option<GridReach>, ModelError> {
         reactions: false,
         ..EvaluateOptions::default()
     };
-    let grid = evaluate_grid(model, &ParameterSet::unbalanced(model), &options)
+    let grid = evaluate_unbalanced_grid(model, &options)
         .map_err(|e| ModelError::invalid("tasks", e.to_string()))?;
     let tasks = &grid.tasks;
     let mut reached = vec![false; tasks.points.len()];
