@@ -130,9 +130,16 @@ pub(crate) fn combo(w: &[f64], v: &[Lanes]) -> [f64; LANE] {
         axpy(&mut s[2], wc[2], &vc[2]);
         axpy(&mut s[3], wc[3], &vc[3]);
     }
-    let tail = w.len() - rem.len();
-    for (k, &x) in rem.iter().enumerate() {
-        axpy(&mut s[k], x, &v[tail + k]);
+    // the remainder by constant indices (a variable index would keep the sums in memory)
+    let tail = &v[w.len() - rem.len()..];
+    if let Some(&x) = rem.first() {
+        axpy(&mut s[0], x, &tail[0]);
+    }
+    if let Some(&x) = rem.get(1) {
+        axpy(&mut s[1], x, &tail[1]);
+    }
+    if let Some(&x) = rem.get(2) {
+        axpy(&mut s[2], x, &tail[2]);
     }
     sum_partials(&s)
 }
@@ -150,16 +157,220 @@ pub(crate) fn sparse_combo(w: &[f64], rows: &[usize], v: &[Lanes]) -> [f64; LANE
         axpy(&mut s[2], w[rc[2]], &v[rc[2]]);
         axpy(&mut s[3], w[rc[3]], &v[rc[3]]);
     }
-    for (k, &r) in rem.iter().enumerate() {
-        axpy(&mut s[k], w[r], &v[r]);
+    // the remainder by constant indices, as in `combo`
+    if let Some(&r) = rem.first() {
+        axpy(&mut s[0], w[r], &v[r]);
+    }
+    if let Some(&r) = rem.get(1) {
+        axpy(&mut s[1], w[r], &v[r]);
+    }
+    if let Some(&r) = rem.get(2) {
+        axpy(&mut s[2], w[r], &v[r]);
     }
     sum_partials(&s)
 }
 
-/// Scratch of [`chunk_solve`]: one row of lanes per equation.
+/// [`combo`] of two chunks at once (`v0`, `v1`): each factor entry is loaded once for both,
+/// and the eight partial sums are independent chains. Each chunk's sums are [`combo`]'s, term
+/// by term, so its bits are the same.
+#[inline(always)]
+pub(crate) fn combo_pair(w: &[f64], v0: &[Lanes], v1: &[Lanes]) -> ([f64; LANE], [f64; LANE]) {
+    let mut s = [[0.0; LANE]; 4];
+    let mut t = [[0.0; LANE]; 4];
+    let chunks = w.chunks_exact(4);
+    let rem = chunks.remainder();
+    for ((wc, c0), c1) in chunks.zip(v0.chunks_exact(4)).zip(v1.chunks_exact(4)) {
+        axpy(&mut s[0], wc[0], &c0[0]);
+        axpy(&mut t[0], wc[0], &c1[0]);
+        axpy(&mut s[1], wc[1], &c0[1]);
+        axpy(&mut t[1], wc[1], &c1[1]);
+        axpy(&mut s[2], wc[2], &c0[2]);
+        axpy(&mut t[2], wc[2], &c1[2]);
+        axpy(&mut s[3], wc[3], &c0[3]);
+        axpy(&mut t[3], wc[3], &c1[3]);
+    }
+    // the remainder by constant indices (a variable index would keep the sums in memory)
+    let tail = w.len() - rem.len();
+    let (r0, r1) = (&v0[tail..], &v1[tail..]);
+    if let Some(&x) = rem.first() {
+        axpy(&mut s[0], x, &r0[0]);
+        axpy(&mut t[0], x, &r1[0]);
+    }
+    if let Some(&x) = rem.get(1) {
+        axpy(&mut s[1], x, &r0[1]);
+        axpy(&mut t[1], x, &r1[1]);
+    }
+    if let Some(&x) = rem.get(2) {
+        axpy(&mut s[2], x, &r0[2]);
+        axpy(&mut t[2], x, &r1[2]);
+    }
+    (sum_partials(&s), sum_partials(&t))
+}
+
+/// [`sparse_combo`] of two chunks at once, as [`combo_pair`].
+#[inline(always)]
+pub(crate) fn sparse_combo_pair(
+    w: &[f64],
+    rows: &[usize],
+    v0: &[Lanes],
+    v1: &[Lanes],
+) -> ([f64; LANE], [f64; LANE]) {
+    let mut s = [[0.0; LANE]; 4];
+    let mut t = [[0.0; LANE]; 4];
+    let chunks = rows.chunks_exact(4);
+    let rem = chunks.remainder();
+    for rc in chunks {
+        axpy(&mut s[0], w[rc[0]], &v0[rc[0]]);
+        axpy(&mut t[0], w[rc[0]], &v1[rc[0]]);
+        axpy(&mut s[1], w[rc[1]], &v0[rc[1]]);
+        axpy(&mut t[1], w[rc[1]], &v1[rc[1]]);
+        axpy(&mut s[2], w[rc[2]], &v0[rc[2]]);
+        axpy(&mut t[2], w[rc[2]], &v1[rc[2]]);
+        axpy(&mut s[3], w[rc[3]], &v0[rc[3]]);
+        axpy(&mut t[3], w[rc[3]], &v1[rc[3]]);
+    }
+    // the remainder by constant indices, as in `combo_pair`
+    if let Some(&r) = rem.first() {
+        axpy(&mut s[0], w[r], &v0[r]);
+        axpy(&mut t[0], w[r], &v1[r]);
+    }
+    if let Some(&r) = rem.get(1) {
+        axpy(&mut s[1], w[r], &v0[r]);
+        axpy(&mut t[1], w[r], &v1[r]);
+    }
+    if let Some(&r) = rem.get(2) {
+        axpy(&mut s[2], w[r], &v0[r]);
+        axpy(&mut t[2], w[r], &v1[r]);
+    }
+    (sum_partials(&s), sum_partials(&t))
+}
+
+/// [`combo`] of four chunks at once, as [`combo_pair`].
+#[inline(always)]
+pub(crate) fn combo_quad(w: &[f64], z: [&[Lanes]; 4]) -> [[f64; LANE]; 4] {
+    let mut s = [[0.0; LANE]; 4];
+    let mut t = [[0.0; LANE]; 4];
+    let mut u = [[0.0; LANE]; 4];
+    let mut v = [[0.0; LANE]; 4];
+    let chunks = w.chunks_exact(4);
+    let rem = chunks.remainder();
+    for (j, wc) in chunks.enumerate() {
+        let j = 4 * j;
+        let (c0, c1, c2, c3) = (
+            &z[0][j..j + 4],
+            &z[1][j..j + 4],
+            &z[2][j..j + 4],
+            &z[3][j..j + 4],
+        );
+        axpy(&mut s[0], wc[0], &c0[0]);
+        axpy(&mut t[0], wc[0], &c1[0]);
+        axpy(&mut u[0], wc[0], &c2[0]);
+        axpy(&mut v[0], wc[0], &c3[0]);
+        axpy(&mut s[1], wc[1], &c0[1]);
+        axpy(&mut t[1], wc[1], &c1[1]);
+        axpy(&mut u[1], wc[1], &c2[1]);
+        axpy(&mut v[1], wc[1], &c3[1]);
+        axpy(&mut s[2], wc[2], &c0[2]);
+        axpy(&mut t[2], wc[2], &c1[2]);
+        axpy(&mut u[2], wc[2], &c2[2]);
+        axpy(&mut v[2], wc[2], &c3[2]);
+        axpy(&mut s[3], wc[3], &c0[3]);
+        axpy(&mut t[3], wc[3], &c1[3]);
+        axpy(&mut u[3], wc[3], &c2[3]);
+        axpy(&mut v[3], wc[3], &c3[3]);
+    }
+    // the remainder by constant indices, as in `combo_pair`
+    let tail = w.len() - rem.len();
+    let r = [&z[0][tail..], &z[1][tail..], &z[2][tail..], &z[3][tail..]];
+    if let Some(&x) = rem.first() {
+        axpy(&mut s[0], x, &r[0][0]);
+        axpy(&mut t[0], x, &r[1][0]);
+        axpy(&mut u[0], x, &r[2][0]);
+        axpy(&mut v[0], x, &r[3][0]);
+    }
+    if let Some(&x) = rem.get(1) {
+        axpy(&mut s[1], x, &r[0][1]);
+        axpy(&mut t[1], x, &r[1][1]);
+        axpy(&mut u[1], x, &r[2][1]);
+        axpy(&mut v[1], x, &r[3][1]);
+    }
+    if let Some(&x) = rem.get(2) {
+        axpy(&mut s[2], x, &r[0][2]);
+        axpy(&mut t[2], x, &r[1][2]);
+        axpy(&mut u[2], x, &r[2][2]);
+        axpy(&mut v[2], x, &r[3][2]);
+    }
+    [
+        sum_partials(&s),
+        sum_partials(&t),
+        sum_partials(&u),
+        sum_partials(&v),
+    ]
+}
+
+/// [`sparse_combo`] of four chunks at once, as [`combo_pair`].
+#[inline(always)]
+pub(crate) fn sparse_combo_quad(w: &[f64], rows: &[usize], z: [&[Lanes]; 4]) -> [[f64; LANE]; 4] {
+    let mut s = [[0.0; LANE]; 4];
+    let mut t = [[0.0; LANE]; 4];
+    let mut u = [[0.0; LANE]; 4];
+    let mut v = [[0.0; LANE]; 4];
+    let chunks = rows.chunks_exact(4);
+    let rem = chunks.remainder();
+    for rc in chunks {
+        let (r, x) = (rc[0], w[rc[0]]);
+        axpy(&mut s[0], x, &z[0][r]);
+        axpy(&mut t[0], x, &z[1][r]);
+        axpy(&mut u[0], x, &z[2][r]);
+        axpy(&mut v[0], x, &z[3][r]);
+        let (r, x) = (rc[1], w[rc[1]]);
+        axpy(&mut s[1], x, &z[0][r]);
+        axpy(&mut t[1], x, &z[1][r]);
+        axpy(&mut u[1], x, &z[2][r]);
+        axpy(&mut v[1], x, &z[3][r]);
+        let (r, x) = (rc[2], w[rc[2]]);
+        axpy(&mut s[2], x, &z[0][r]);
+        axpy(&mut t[2], x, &z[1][r]);
+        axpy(&mut u[2], x, &z[2][r]);
+        axpy(&mut v[2], x, &z[3][r]);
+        let (r, x) = (rc[3], w[rc[3]]);
+        axpy(&mut s[3], x, &z[0][r]);
+        axpy(&mut t[3], x, &z[1][r]);
+        axpy(&mut u[3], x, &z[2][r]);
+        axpy(&mut v[3], x, &z[3][r]);
+    }
+    // the remainder by constant indices, as in `combo_pair`
+    if let Some(&r) = rem.first() {
+        axpy(&mut s[0], w[r], &z[0][r]);
+        axpy(&mut t[0], w[r], &z[1][r]);
+        axpy(&mut u[0], w[r], &z[2][r]);
+        axpy(&mut v[0], w[r], &z[3][r]);
+    }
+    if let Some(&r) = rem.get(1) {
+        axpy(&mut s[1], w[r], &z[0][r]);
+        axpy(&mut t[1], w[r], &z[1][r]);
+        axpy(&mut u[1], w[r], &z[2][r]);
+        axpy(&mut v[1], w[r], &z[3][r]);
+    }
+    if let Some(&r) = rem.get(2) {
+        axpy(&mut s[2], w[r], &z[0][r]);
+        axpy(&mut t[2], w[r], &z[1][r]);
+        axpy(&mut u[2], w[r], &z[2][r]);
+        axpy(&mut v[2], w[r], &z[3][r]);
+    }
+    [
+        sum_partials(&s),
+        sum_partials(&t),
+        sum_partials(&u),
+        sum_partials(&v),
+    ]
+}
+
+/// Scratch of [`chunk_solve`]: per chunk solved together (up to four), one row of lanes per
+/// equation.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SolveScratch {
-    z: Vec<Lanes>,
+    z: [Vec<Lanes>; 4],
 }
 
 /// The factor `S = L Lᵀ` in the two layouts the substitutions read contiguously.
@@ -177,9 +388,13 @@ pub(crate) struct Factor<'a> {
 
 crate::simd::multiversion! {
 /// `y = Aᵀ (L Lᵀ)⁻¹ b` for `m` right-hand sides (`b` row-major `rows × m`; `y` row-major
-/// `k × m`), [`LANE`] right-hand sides at a time. Both substitutions
-/// are in dot-product form over contiguous rows: the inner loop keeps four independent
-/// accumulators in registers and stores each unknown once.
+/// `k × m`) in chunks of [`LANE`], four chunks at a time, then two, then one. Both
+/// substitutions are in dot-product form over contiguous rows: the inner loop keeps four
+/// independent accumulators per chunk in registers and stores each unknown once; chunks solved
+/// together share each load of a factor entry (the palletizer's final grid evaluation at
+/// Dmax 2: 2.03 s against 2.30 s one chunk at a time). Every lane receives the same
+/// operations in the same order however its chunk is solved, so a right-hand side's bits do
+/// not depend on `m` or on its position.
 pub(crate) fn chunk_solve(
     factor: Factor<'_>,
     a: &[f64],
@@ -190,9 +405,22 @@ pub(crate) fn chunk_solve(
     y: &mut [f64],
     z: &mut SolveScratch,
 ) {
-    z.z.resize(factor.rows, Lanes::default());
-    for c0 in (0..m).step_by(LANE) {
-        solve_lanes(factor, a, nz, k, b, m, c0, y, &mut z.z);
+    for zc in &mut z.z {
+        zc.resize(factor.rows, Lanes::default());
+    }
+    let mut c0 = 0;
+    while c0 + 4 * LANE <= m {
+        solve_lane_quad(factor, a, nz, k, b, m, c0, y, &mut z.z);
+        c0 += 4 * LANE;
+    }
+    let [z0, z1, ..] = &mut z.z;
+    if c0 + 2 * LANE <= m {
+        solve_lane_pair(factor, a, nz, k, b, m, c0, y, z0, z1);
+        c0 += 2 * LANE;
+    }
+    while c0 < m {
+        solve_lanes(factor, a, nz, k, b, m, c0, y, z0);
+        c0 += LANE;
     }
 }
 }
@@ -241,6 +469,122 @@ pub(crate) fn solve_lanes(
         let col = &a[c * rows..(c + 1) * rows];
         let acc = sparse_combo(col, &nz[c], z);
         y[c * m + c0..c * m + c0 + width].copy_from_slice(&acc[..width]);
+    }
+}
+
+/// [`solve_lanes`] of the two whole chunks at `c0` and `c0 + LANE`, with the paired combos:
+/// every lane receives [`solve_lanes`]' operations in the same order.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solve_lane_pair(
+    factor: Factor<'_>,
+    a: &[f64],
+    nz: &[Vec<usize>],
+    k: usize,
+    b: &[f64],
+    m: usize,
+    c0: usize,
+    y: &mut [f64],
+    z0: &mut [Lanes],
+    z1: &mut [Lanes],
+) {
+    let rows = factor.rows;
+    let c1 = c0 + LANE;
+    // L z = b
+    for i in 0..rows {
+        let (s0, s1) = combo_pair(&factor.l[i * rows..i * rows + i], &z0[..i], &z1[..i]);
+        let d = factor.inv_diag[i];
+        let mut x0 = lane(&b[i * m + c0..i * m + c0 + LANE]);
+        let mut x1 = lane(&b[i * m + c1..i * m + c1 + LANE]);
+        for p in 0..LANE {
+            x0[p] = (x0[p] - s0[p]) * d;
+            x1[p] = (x1[p] - s1[p]) * d;
+        }
+        z0[i] = Lanes(x0);
+        z1[i] = Lanes(x1);
+    }
+    // Lᵀ y = z
+    for i in (0..rows).rev() {
+        let row = &factor.lt[i * factor.stride + i + 1..i * factor.stride + rows];
+        let (s0, s1) = combo_pair(row, &z0[i + 1..rows], &z1[i + 1..rows]);
+        let d = factor.inv_diag[i];
+        let (mut x0, mut x1) = (z0[i].0, z1[i].0);
+        for p in 0..LANE {
+            x0[p] = (x0[p] - s0[p]) * d;
+            x1[p] = (x1[p] - s1[p]) * d;
+        }
+        z0[i] = Lanes(x0);
+        z1[i] = Lanes(x1);
+    }
+    // λ = Aᵀ y
+    for c in 0..k {
+        let col = &a[c * rows..(c + 1) * rows];
+        let (y0, y1) = sparse_combo_pair(col, &nz[c], z0, z1);
+        y[c * m + c0..c * m + c0 + LANE].copy_from_slice(&y0);
+        y[c * m + c1..c * m + c1 + LANE].copy_from_slice(&y1);
+    }
+}
+
+/// [`solve_lanes`] of the four whole chunks from `c0`, with the quad combos.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solve_lane_quad(
+    factor: Factor<'_>,
+    a: &[f64],
+    nz: &[Vec<usize>],
+    k: usize,
+    b: &[f64],
+    m: usize,
+    c0: usize,
+    y: &mut [f64],
+    z: &mut [Vec<Lanes>; 4],
+) {
+    let rows = factor.rows;
+    // L z = b
+    for i in 0..rows {
+        let s = combo_quad(
+            &factor.l[i * rows..i * rows + i],
+            [&z[0][..i], &z[1][..i], &z[2][..i], &z[3][..i]],
+        );
+        let d = factor.inv_diag[i];
+        for (c, (zc, sc)) in z.iter_mut().zip(&s).enumerate() {
+            let f = c0 + c * LANE;
+            let mut x = lane(&b[i * m + f..i * m + f + LANE]);
+            for p in 0..LANE {
+                x[p] = (x[p] - sc[p]) * d;
+            }
+            zc[i] = Lanes(x);
+        }
+    }
+    // Lᵀ y = z
+    for i in (0..rows).rev() {
+        let row = &factor.lt[i * factor.stride + i + 1..i * factor.stride + rows];
+        let s = combo_quad(
+            row,
+            [
+                &z[0][i + 1..rows],
+                &z[1][i + 1..rows],
+                &z[2][i + 1..rows],
+                &z[3][i + 1..rows],
+            ],
+        );
+        let d = factor.inv_diag[i];
+        for (zc, sc) in z.iter_mut().zip(&s) {
+            let mut x = zc[i].0;
+            for p in 0..LANE {
+                x[p] = (x[p] - sc[p]) * d;
+            }
+            zc[i] = Lanes(x);
+        }
+    }
+    // λ = Aᵀ y
+    for c in 0..k {
+        let col = &a[c * rows..(c + 1) * rows];
+        let s = sparse_combo_quad(col, &nz[c], [&z[0], &z[1], &z[2], &z[3]]);
+        for (q, sq) in s.iter().enumerate() {
+            let f = c0 + q * LANE;
+            y[c * m + f..c * m + f + LANE].copy_from_slice(sq);
+        }
     }
 }
 

@@ -396,6 +396,60 @@ fn balanced_witness_has_no_static_torque() {
     }
 }
 
+/// The substitution solve takes its right-hand sides in chunks of 32, 16 and 8 (then the
+/// rest); every lane receives the same operations in any chunk, so a right-hand side's joint
+/// wrenches are the same bits solved alone as in a batch of 61 (32 + 16 + 8 + 5), at any
+/// position. The second method is the reaction operator of the same factorisation (its own
+/// products, to 1e-12 of the largest wrench).
+#[test]
+fn substitution_solve_bits_do_not_depend_on_the_batch() {
+    use counterpoise_dynamics::lu::SmallLu;
+    use counterpoise_dynamics::mechanism::Scratch;
+    use counterpoise_dynamics::reactions::ReactionWork;
+    let model = case("palletizer");
+    let ev = Evaluator::new(&model).unwrap();
+    let mech = &ev.mech;
+    let mut rng = SplitMix64::new(43);
+    let rows = 6 * mech.body_count;
+    let out_rows = 6 * ev.reactions.joint_count();
+    let (q, _, _) = random_state(&model, &mut rng);
+    let mut scratch = Scratch::default();
+    mech.eval_poses(&q, &mut scratch);
+    let pose = scratch.pose.clone();
+    let kin: Vec<_> = (0..mech.body_count)
+        .map(|b| mech.body_frame(&pose, b))
+        .collect();
+    let mut u = vec![0.0; 12];
+    let mut g = vec![0.0; 144];
+    mech.actuator_map(&q, &mut scratch, &mut u, &mut g);
+    let lu = SmallLu::new(&g, mech.n);
+    let mut work = ReactionWork::default();
+    ev.reactions.prepare(mech, &pose, &kin, &lu, &mut work);
+    let m = 61;
+    let b: Vec<f64> = (0..rows * m).map(|_| rng.uniform(-100.0, 100.0)).collect();
+    let mut batch = vec![0.0; out_rows * m];
+    ev.reactions
+        .solve_prepared(&mut work, &mut b.clone(), m, &mut batch);
+    // every chunk: the quad (0–31), the pair (32–47), the single (48–55), the rest (56–60)
+    for p in [0, 9, 31, 32, 40, 47, 48, 55, 56, 60] {
+        let mut column: Vec<f64> = (0..rows).map(|r| b[r * m + p]).collect();
+        let mut alone = vec![0.0; out_rows];
+        ev.reactions
+            .solve_prepared(&mut work, &mut column, 1, &mut alone);
+        for r in 0..out_rows {
+            assert_eq!(alone[r].to_bits(), batch[r * m + p].to_bits(), "{p} {r}");
+        }
+    }
+    ev.reactions.prepare_operator(&mut work);
+    let mut applied = vec![0.0; out_rows * m];
+    ev.reactions.apply_operator(&work, &b, m, m, &mut applied);
+    let scale = batch.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    assert!(scale > 1.0);
+    for (x, y) in batch.iter().zip(&applied) {
+        assert!((x - y).abs() <= 1e-12 * scale, "{x} vs {y}");
+    }
+}
+
 /// The reaction operator of the grid evaluation (`O`, solved once per sample for the unit
 /// right-hand sides) against the substitution solve of every right-hand side: the same joint
 /// wrenches to rounding; and applied to one column alone or to a block of 20 inside wider rows,
