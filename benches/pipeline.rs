@@ -31,7 +31,9 @@ use counterpoise_dynamics::{
     evaluate_unbalanced_grid,
 };
 use counterpoise_model::{Case, Model};
-use counterpoise_optimise::{Context, OptimiseOptions, OptimisedVariant, optimise_all};
+use counterpoise_optimise::{
+    Context, FinalReactionSolve, OptimiseOptions, OptimisedVariant, optimise_all,
+};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn palletizer() -> Model {
@@ -44,7 +46,12 @@ fn study(model: &Model, dmax: usize) -> Vec<OptimisedVariant> {
     let mut ub = evaluate_unbalanced_grid(model, &EvaluateOptions::default()).expect("phase 1");
     let variants = balanced(model, dmax);
     let ctx = Context::new(model, Some(ub.indicators.swap_remove(0))).expect("context");
-    optimise_all(&ctx, &variants, &OptimiseOptions::default())
+    // the final evaluation's reaction solve as a study chooses it
+    let options = OptimiseOptions {
+        final_reaction_solve: FinalReactionSolve::for_study(model, variants.len()),
+        ..OptimiseOptions::default()
+    };
+    optimise_all(&ctx, &variants, &options)
 }
 
 /// `count` three-element variants over the bodies and spring slots of the palletizer's

@@ -1,12 +1,13 @@
 //! The streaming grid evaluation (running maxima per column, no per-task table) gives exactly
-//! the indicators of the full table's reduction, for any thread count.
+//! the indicators of the full table's reduction, for any thread count; a batch's reactions by
+//! substitution agree with the reaction operator's and do not depend on the batch.
 
 mod common;
 
 use common::coarse_palletizer;
 use counterpoise_dynamics::{
-    Counterweight, EvaluateOptions, ParameterSet, Spring, Variant, evaluate_grid,
-    evaluate_grid_indicators,
+    Combination, Counterweight, EvaluateOptions, ParameterSet, Spring, Variant, evaluate_grid,
+    evaluate_grid_indicators, evaluate_grid_indicators_with,
 };
 
 fn variants(model: &counterpoise_model::Model) -> Vec<Variant> {
@@ -80,5 +81,59 @@ fn streaming_indicators_equal_the_table_reduction() {
         }
         // Two identical columns have identical indicators, critical tasks included.
         assert_eq!(table.indicators[0], table.indicators[3]);
+    }
+}
+
+/// A study's final evaluation may solve a batch's reactions by substitution instead of
+/// through the reaction operator (`FinalReactionSolve` in the optimiser). On a batch with
+/// three inertia groups, counterweights and springs: every column's joint reaction peaks
+/// agree with the operator's to 1e-12 relative (the second method), its motor torque
+/// indicators are the same bits (they do not pass through the reaction solve), and each
+/// column evaluated alone by substitution has the same bits as in the batch — a shard's
+/// figures equal the single run's under either choice.
+#[test]
+fn a_batch_by_substitution_matches_the_operator_and_each_column_alone() {
+    let model = coarse_palletizer();
+    let variants = variants(&model);
+    let params = ParameterSet::from_variants(&model, &variants).unwrap();
+    let options = EvaluateOptions::default();
+    let evaluate = |params: &ParameterSet, combination| {
+        evaluate_grid_indicators_with(&model, params, &options, combination)
+            .unwrap()
+            .indicators
+    };
+    let by_operator = evaluate(&params, Combination::Direct);
+    let by_substitution = evaluate(&params, Combination::Substitution);
+    let mut loaded = 0;
+    for (c, (a, b)) in by_operator.iter().zip(&by_substitution).enumerate() {
+        assert_eq!(a.joints.len(), 11);
+        for (j, (ja, jb)) in a.joints.iter().zip(&b.joints).enumerate() {
+            for (x, y) in [(ja.force, jb.force), (ja.moment, jb.moment)] {
+                // (a joint that carries nothing has exact zeros both ways)
+                assert!((x - y).abs() <= 1e-12 * x, "{c} {j}: {x} {y}");
+                loaded += usize::from(x > 0.0);
+            }
+        }
+        assert_eq!(
+            (&a.actuators, a.qtr, a.qtr_task, a.qit, a.qit_task),
+            (&b.actuators, b.qtr, b.qtr_task, b.qit, b.qit_task),
+            "{c}"
+        );
+    }
+    assert!(loaded >= 4 * 18, "{loaded} loaded joint peaks");
+    // the balancing elements change the reactions: three columns, three sets of peaks
+    let peaks = |c: usize| -> Vec<f64> {
+        let joints = &by_substitution[c].joints;
+        joints.iter().flat_map(|j| [j.force, j.moment]).collect()
+    };
+    assert!(peaks(1) != peaks(0) && peaks(2) != peaks(0) && peaks(1) != peaks(2));
+    assert_eq!(peaks(3), peaks(0));
+    for (c, variant) in variants.iter().enumerate() {
+        let alone = ParameterSet::from_variants(&model, std::slice::from_ref(variant)).unwrap();
+        assert_eq!(
+            evaluate(&alone, Combination::Substitution)[0],
+            by_substitution[c],
+            "{c}"
+        );
     }
 }

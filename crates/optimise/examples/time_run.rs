@@ -16,7 +16,9 @@ use counterpoise_balance::{
 };
 use counterpoise_dynamics::{EvaluateOptions, evaluate_unbalanced_grid};
 use counterpoise_model::Case;
-use counterpoise_optimise::{Context, OptimiseOptions, StageTime, Stopwatch, optimise_all_timed};
+use counterpoise_optimise::{
+    Context, FinalReactionSolve, OptimiseOptions, StageTime, Stopwatch, optimise_all_timed,
+};
 
 fn median_range(mut v: Vec<f64>) -> String {
     v.sort_by(f64::total_cmp);
@@ -72,7 +74,17 @@ fn main() {
         let t = Stopwatch::start();
         let ctx = Context::new(&model, Some(ub.indicators.swap_remove(0))).expect("context");
         let context = t.elapsed();
-        let (out, stages) = optimise_all_timed(&ctx, &report.variants, &OptimiseOptions::default());
+        // as a study sets it, from the whole search
+        let balanced = report
+            .variants
+            .iter()
+            .filter(|v| v.status == Status::Balanced)
+            .count();
+        let options = OptimiseOptions {
+            final_reaction_solve: FinalReactionSolve::for_study(&model, balanced),
+            ..OptimiseOptions::default()
+        };
+        let (out, stages) = optimise_all_timed(&ctx, &report.variants, &options);
         let total = start.elapsed();
         let row = [
             phase1,

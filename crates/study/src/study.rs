@@ -17,7 +17,9 @@ use counterpoise_balance::{
 };
 use counterpoise_dynamics::{EvaluateOptions, Indicators, evaluate_unbalanced_grid};
 use counterpoise_model::{Model, ModelError};
-use counterpoise_optimise::{Context, Objective, OptimiseOptions, optimise_all_reporting};
+use counterpoise_optimise::{
+    Context, FinalReactionSolve, Objective, OptimiseOptions, optimise_all_reporting,
+};
 use counterpoise_report as report;
 use report::{PhaseTiming, RankingOptions, RunMetadata, RunResults};
 
@@ -350,11 +352,19 @@ impl<'m> Study<'m> {
         timer.time_reporting(phase, |phase| {
             let context = Context::new(model, Some(front.unbalanced.clone()))?;
             let defaults = OptimiseOptions::default();
+            // From the whole search, not this phase's share: every shard chooses alike.
+            let balanced = front
+                .found
+                .variants
+                .iter()
+                .filter(|v| v.status == Status::Balanced)
+                .count();
             let settings = OptimiseOptions {
                 objective,
                 gap_tolerance: search.gap,
                 max_nodes: search.max_nodes,
                 start_seed: search.seed.unwrap_or(defaults.start_seed),
+                final_reaction_solve: FinalReactionSolve::for_study(model, balanced),
                 ..defaults
             };
             let report = |p: counterpoise_optimise::StageProgress| {

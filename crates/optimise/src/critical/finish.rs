@@ -153,7 +153,13 @@ pub(super) fn finish(
     let final_indicators = if variants.is_empty() {
         Ok(Vec::new())
     } else {
-        grid_indicators(ctx, &variants, options.final_reactions, &share)
+        grid_indicators(
+            ctx,
+            &variants,
+            options.final_reactions,
+            options.final_reaction_solve.combination(),
+            &share,
+        )
     };
     let mut indicators_of: Vec<Option<Result<Indicators, String>>> = vec![None; runs.len()];
     for (n, &k) in finals.iter().enumerate() {

@@ -81,6 +81,7 @@ pub(super) fn grid_indicators(
     ctx: &Context,
     variants: &[Variant],
     reactions: bool,
+    combination: Combination,
     share: &ShareCounter,
 ) -> Result<Vec<Indicators>, String> {
     let to_base: Vec<bool> = variants
@@ -89,7 +90,9 @@ pub(super) fn grid_indicators(
         .collect();
     if to_base.iter().all(|&b| b) || to_base.iter().all(|&b| !b) {
         let n = variants.len();
-        return batch_indicators(ctx, variants, reactions, &|d, t| share.batch(0, n, d, t));
+        return batch_indicators(ctx, variants, reactions, combination, &|d, t| {
+            share.batch(0, n, d, t)
+        });
     }
     let with_base_count = to_base.iter().filter(|&&b| b).count();
     let part = |base: bool| -> Result<Vec<Indicators>, String> {
@@ -102,7 +105,7 @@ pub(super) fn grid_indicators(
         // The batch with springs to the base runs first.
         let before = if base { 0 } else { with_base_count };
         let n = members.len();
-        batch_indicators(ctx, &members, reactions, &|d, t| {
+        batch_indicators(ctx, &members, reactions, combination, &|d, t| {
             share.batch(before, n, d, t)
         })
     };
@@ -121,6 +124,7 @@ pub(super) fn batch_indicators(
     ctx: &Context,
     variants: &[Variant],
     reactions: bool,
+    combination: Combination,
     progress: GridProgress,
 ) -> Result<Vec<Indicators>, String> {
     let params = ParameterSet::from_variants(&ctx.model, variants).map_err(|e| e.to_string())?;
@@ -132,7 +136,7 @@ pub(super) fn batch_indicators(
         &ctx.model,
         &params,
         &evaluate_options,
-        Combination::Direct,
+        combination,
         progress,
     )
     .map_err(|e| e.to_string())?;

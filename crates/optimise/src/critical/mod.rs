@@ -21,6 +21,7 @@ use std::collections::BTreeSet;
 
 use counterpoise_balance::linear::solve;
 use counterpoise_balance::{Status, VariantResult};
+use counterpoise_dynamics::Combination;
 use nalgebra::DVector;
 use rayon::prelude::*;
 
@@ -41,7 +42,7 @@ use state::*;
 
 pub use grid::objective_of;
 pub use peaks::{delta_r, lowest_delta_r};
-pub use state::{OptimiseOptions, StageTimings};
+pub use state::{FinalReactionSolve, OptimiseOptions, StageTimings};
 
 /// Optimises one balanced variant (see [`optimise_all`]).
 pub fn optimise_variant(
@@ -153,7 +154,8 @@ fn critical_task_loop(
             evaluated.len(),
         );
         let dyn_variants = candidate_variants(&ctx.model, runs, &evaluated);
-        let indicators = grid_indicators(ctx, &dyn_variants, false, &share);
+        // without reactions the combination does not matter
+        let indicators = grid_indicators(ctx, &dyn_variants, false, Combination::Direct, &share);
         timings.loop_grid += started.elapsed();
         let indicators = match indicators {
             Ok(i) => i,

@@ -23,6 +23,12 @@ pub struct OptimiseOptions {
     pub spring_starts: usize,
     /// Compute joint reactions in the final all-task evaluation (F_j, M_j, ΔR).
     pub final_reactions: bool,
+    /// How the final all-task evaluation solves each sample's joint reactions. A variant's
+    /// figures are the same bits in any batch under one choice, and differ in the last bits
+    /// between the two; a study sets it from its whole balance search
+    /// ([`FinalReactionSolve::for_study`]) so that every shard makes the same choice.
+    #[serde(default)]
+    pub final_reaction_solve: FinalReactionSolve,
     /// clarabel iteration limit.
     pub solver_iterations: u32,
     /// Boxes the certified search ([`crate::certify`]) solves at most per variant and pass: the
@@ -36,6 +42,52 @@ pub struct OptimiseOptions {
     /// two seeds).
     #[serde(default = "default_start_seed")]
     pub start_seed: u64,
+}
+
+/// How the final all-task evaluation solves the joint reactions of a sample for the batch's
+/// right-hand sides (every finalist, and three per inertia group).
+///
+/// The reaction operator costs one substitution per body wrench row to form (`6L`, 48 on the
+/// palletizer) and then less than a substitution per right-hand side, so it pays for large
+/// batches only. Measured on the palletizer's final evaluation (release, 2 cores, one run
+/// each): at Dmax 2 (50 finalists in 14 inertia groups, 92 right-hand sides per sample)
+/// substitution takes 2.08 s against the operator's 2.28 s; at Dmax 3 (788 finalists) the
+/// operator takes 25.8 s against substitution's 29.3 s. [`Self::for_study`] switches at
+/// `2.5 · 6L` balanced variants, on the Dmax 2 side of that range.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FinalReactionSolve {
+    /// Through the sample's reaction operator (large batches).
+    #[default]
+    Operator,
+    /// By substitution in the sample's factorisation, right-hand side by right-hand side
+    /// (small batches).
+    Substitution,
+}
+
+impl FinalReactionSolve {
+    /// The choice for a study whose balance search found `balanced` variants. The final
+    /// batch's right-hand sides per sample are not known before the optimisation (its
+    /// finalists and their inertia groups); the balanced count bounds the finalists and,
+    /// unlike them, is the same in every shard of the study. On the palletizer it tracks
+    /// them: 97 balanced variants at Dmax 2 give 92 right-hand sides per sample.
+    pub fn for_study(model: &counterpoise_model::Model, balanced: usize) -> Self {
+        // 2.5 · 6L, in integers
+        let crossover = 15 * model.bodies.len();
+        if balanced <= crossover {
+            FinalReactionSolve::Substitution
+        } else {
+            FinalReactionSolve::Operator
+        }
+    }
+
+    /// The dynamics crate's way of combining a batch that makes this choice.
+    pub fn combination(self) -> counterpoise_dynamics::Combination {
+        match self {
+            FinalReactionSolve::Operator => counterpoise_dynamics::Combination::Direct,
+            FinalReactionSolve::Substitution => counterpoise_dynamics::Combination::Substitution,
+        }
+    }
 }
 
 pub(super) fn default_start_seed() -> u64 {
@@ -66,6 +118,7 @@ impl Default for OptimiseOptions {
             gap_tolerance: 1e-3,
             spring_starts: 8,
             final_reactions: true,
+            final_reaction_solve: FinalReactionSolve::default(),
             solver_iterations: 200,
             max_nodes: crate::certify::DEFAULT_MAX_NODES,
             start_seed: crate::springs::DEFAULT_SEED,

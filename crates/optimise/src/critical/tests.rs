@@ -213,6 +213,7 @@ fn the_final_checks_decide_the_verdict() {
             &ctx,
             &candidate_variants(&ctx.model, std::slice::from_ref(run), &[0]),
             true,
+            options.final_reaction_solve.combination(),
             &crate::progress::ShareCounter::start(
                 &crate::progress::silent,
                 "final evaluation",
@@ -899,5 +900,32 @@ fn boxes_solved_together_are_the_boxes_solved_alone() {
     assert!(
         rows_used > 0,
         "no child used a peak row: the test proves nothing"
+    );
+}
+
+/// The final evaluation's reaction solve follows the study's balanced count: substitution up
+/// to 2.5 · 6L right-hand sides (the palletizer's 8 bodies: 120), the operator above. The
+/// palletizer's searches fall on either side: 97 balanced variants at Dmax 2, 1169 at Dmax 3
+/// (the counts `variants` lists).
+#[test]
+fn the_final_reaction_solve_follows_the_study_size() {
+    let model = model(&case_json("palletizer.json"));
+    assert_eq!(model.bodies.len(), 8);
+    let choice = |n| FinalReactionSolve::for_study(&model, n);
+    assert_eq!(choice(97), FinalReactionSolve::Substitution);
+    assert_eq!(choice(120), FinalReactionSolve::Substitution);
+    assert_eq!(choice(121), FinalReactionSolve::Operator);
+    assert_eq!(choice(1169), FinalReactionSolve::Operator);
+    assert_eq!(
+        FinalReactionSolve::Substitution.combination(),
+        counterpoise_dynamics::Combination::Substitution
+    );
+    assert_eq!(
+        FinalReactionSolve::Operator.combination(),
+        counterpoise_dynamics::Combination::Direct
+    );
+    assert_eq!(
+        OptimiseOptions::default().final_reaction_solve,
+        FinalReactionSolve::Operator
     );
 }
