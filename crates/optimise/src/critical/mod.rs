@@ -92,6 +92,24 @@ pub fn optimise_all_reporting(
     (out, timings)
 }
 
+/// The runs `active` in the order a pass starts them: those with counterweights first (their
+/// relaxations are larger, and on the palletizer at Dmax 2 they take 0.02–0.66 s against
+/// 0.01–0.03 s for two springs), each group in index order. A pass hands them out one at a
+/// time in this order (`par_bridge`), so a long variant starts early instead of last in a
+/// thread's half of the range while the other thread idles. Each outcome depends on its run
+/// alone: the order changes when a variant is solved, never what it gets.
+fn heaviest_first(runs: &[Run], active: &[usize]) -> Vec<usize> {
+    let counterweights = |k: usize| {
+        runs[k]
+            .problem
+            .as_ref()
+            .map_or(0, |p| p.counterweights.len())
+    };
+    let mut order = active.to_vec();
+    order.sort_by_key(|&k| (std::cmp::Reverse(counterweights(k)), k));
+    order
+}
+
 /// The passes of the critical-task loop (Proc-5…8): every run leaves it converged, stopped
 /// after `max_iterations` passes, discarded or undecided.
 fn critical_task_loop(
@@ -122,15 +140,17 @@ fn critical_task_loop(
         let counter =
             StageCounter::start(progress, "critical-task pass", timings.passes, active.len());
         type Outcome = (usize, Result<Candidate, Failure>, Option<SearchState>);
-        let outcomes: Vec<Outcome> = active
-            .par_iter()
-            .map(|&k| {
+        let mut outcomes: Vec<Outcome> = heaviest_first(runs, &active)
+            .into_iter()
+            .par_bridge()
+            .map(|k| {
                 let mut search = runs[k].search.clone();
                 let outcome = step(ctx, &runs[k], &failed, options, &mut search);
                 counter.tick();
                 (k, outcome, search)
             })
             .collect();
+        outcomes.sort_by_key(|o| o.0);
         timings.solve += started.elapsed();
         let started = Stopwatch::start();
         let mut evaluated: Vec<usize> = Vec::new();
