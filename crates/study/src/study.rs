@@ -353,12 +353,7 @@ impl<'m> Study<'m> {
             let context = Context::new(model, Some(front.unbalanced.clone()))?;
             let defaults = OptimiseOptions::default();
             // From the whole search, not this phase's share: every shard chooses alike.
-            let balanced = front
-                .found
-                .variants
-                .iter()
-                .filter(|v| v.status == Status::Balanced)
-                .count();
+            let balanced = balanced_ids(&front.found.variants).len();
             let settings = OptimiseOptions {
                 objective,
                 gap_tolerance: search.gap,

@@ -904,7 +904,7 @@ fn boxes_solved_together_are_the_boxes_solved_alone() {
 }
 
 /// The final evaluation's reaction solve follows the study's balanced count: substitution up
-/// to 2.5 · 6L right-hand sides (the palletizer's 8 bodies: 120), the operator above. The
+/// to 2.5 · 6L balanced variants (the palletizer's 8 bodies: 120), the operator above. The
 /// palletizer's searches fall on either side: 97 balanced variants at Dmax 2, 1169 at Dmax 3
 /// (the counts `variants` lists).
 #[test]
