@@ -10,7 +10,7 @@ mod common;
 use std::collections::BTreeMap;
 
 use common::variants::balanced;
-use common::{assert_success, counterpoise, reduced_palletizer, results, write_case};
+use common::{reduced_palletizer, results, run_reduced_palletizer};
 
 use counterpoise_dynamics::{EvaluateOptions, evaluate_unbalanced_grid};
 use counterpoise_model::Case;
@@ -64,19 +64,10 @@ fn run_peaks(results: &serde_json::Value) -> Peaks {
 #[test]
 fn run_solves_the_final_reactions_as_its_study_size_chooses() {
     let dir = tempfile::tempdir().unwrap();
-    let case_json = reduced_palletizer(3, 11);
-    let case = write_case(dir.path(), "palletizer.json", &case_json);
-    let out = dir.path().join("out");
-    assert_success(&counterpoise(&[
-        "run",
-        &case,
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]));
-    let from_run = run_peaks(&results(&out));
+    let from_run = run_peaks(&results(&run_reduced_palletizer(dir.path())));
 
-    let model = Case::from_json_str(&case_json.to_string()).unwrap();
+    // the case that run: the palletizer on its reduced grid
+    let model = Case::from_json_str(&reduced_palletizer(2, 11).to_string()).unwrap();
     let balanced = balanced(&model, 2);
     assert_eq!(balanced.len(), 97);
     assert_eq!(

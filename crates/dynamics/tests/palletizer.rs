@@ -396,23 +396,17 @@ fn balanced_witness_has_no_static_torque() {
     }
 }
 
-/// The substitution solve takes its right-hand sides in chunks of 32, 16 and 8 (then the
-/// rest); every lane receives the same operations in any chunk, so a right-hand side's joint
-/// wrenches are the same bits solved alone as in a batch of 61 (32 + 16 + 8 + 5), at any
-/// position. The second method is the reaction operator of the same factorisation (its own
-/// products, to 1e-12 of the largest wrench).
-#[test]
-fn substitution_solve_bits_do_not_depend_on_the_batch() {
+/// The reaction equations of the palletizer factored at a random configuration (the state
+/// `rng` draws next), as the grid evaluation prepares a sample.
+fn prepared_sample(
+    model: &Model,
+    ev: &Evaluator,
+    rng: &mut SplitMix64,
+) -> counterpoise_dynamics::reactions::ReactionWork {
     use counterpoise_dynamics::lu::SmallLu;
     use counterpoise_dynamics::mechanism::Scratch;
-    use counterpoise_dynamics::reactions::ReactionWork;
-    let model = case("palletizer");
-    let ev = Evaluator::new(&model).unwrap();
     let mech = &ev.mech;
-    let mut rng = SplitMix64::new(43);
-    let rows = 6 * mech.body_count;
-    let out_rows = 6 * ev.reactions.joint_count();
-    let (q, _, _) = random_state(&model, &mut rng);
+    let (q, _, _) = random_state(model, rng);
     let mut scratch = Scratch::default();
     mech.eval_poses(&q, &mut scratch);
     let pose = scratch.pose.clone();
@@ -423,8 +417,24 @@ fn substitution_solve_bits_do_not_depend_on_the_batch() {
     let mut g = vec![0.0; 144];
     mech.actuator_map(&q, &mut scratch, &mut u, &mut g);
     let lu = SmallLu::new(&g, mech.n);
-    let mut work = ReactionWork::default();
+    let mut work = Default::default();
     ev.reactions.prepare(mech, &pose, &kin, &lu, &mut work);
+    work
+}
+
+/// The substitution solve takes its right-hand sides in chunks of 32, 16 and 8 (then the
+/// rest); every lane receives the same operations in any chunk, so a right-hand side's joint
+/// wrenches are the same bits solved alone as in a batch of 61 (32 + 16 + 8 + 5), at any
+/// position. The second method is the reaction operator of the same factorisation (its own
+/// products, to 1e-12 of the largest wrench).
+#[test]
+fn substitution_solve_bits_do_not_depend_on_the_batch() {
+    let model = case("palletizer");
+    let ev = Evaluator::new(&model).unwrap();
+    let mut rng = SplitMix64::new(43);
+    let rows = 6 * ev.mech.body_count;
+    let out_rows = 6 * ev.reactions.joint_count();
+    let mut work = prepared_sample(&model, &ev, &mut rng);
     let m = 61;
     let b: Vec<f64> = (0..rows * m).map(|_| rng.uniform(-100.0, 100.0)).collect();
     let mut batch = vec![0.0; out_rows * m];
@@ -457,29 +467,13 @@ fn substitution_solve_bits_do_not_depend_on_the_batch() {
 /// width, the value may not).
 #[test]
 fn reaction_operator_matches_the_substitution_solve() {
-    use counterpoise_dynamics::lu::SmallLu;
-    use counterpoise_dynamics::mechanism::Scratch;
-    use counterpoise_dynamics::reactions::ReactionWork;
     let model = case("palletizer");
     let ev = Evaluator::new(&model).unwrap();
-    let mech = &ev.mech;
     let mut rng = SplitMix64::new(41);
-    let rows = 6 * mech.body_count;
+    let rows = 6 * ev.mech.body_count;
     let out_rows = 6 * ev.reactions.joint_count();
     for _ in 0..3 {
-        let (q, _, _) = random_state(&model, &mut rng);
-        let mut scratch = Scratch::default();
-        mech.eval_poses(&q, &mut scratch);
-        let pose = scratch.pose.clone();
-        let kin: Vec<_> = (0..mech.body_count)
-            .map(|b| mech.body_frame(&pose, b))
-            .collect();
-        let mut u = vec![0.0; 12];
-        let mut g = vec![0.0; 144];
-        mech.actuator_map(&q, &mut scratch, &mut u, &mut g);
-        let lu = SmallLu::new(&g, mech.n);
-        let mut work = ReactionWork::default();
-        ev.reactions.prepare(mech, &pose, &kin, &lu, &mut work);
+        let mut work = prepared_sample(&model, &ev, &mut rng);
         let m = 37;
         let b: Vec<f64> = (0..rows * m).map(|_| rng.uniform(-100.0, 100.0)).collect();
         let mut solved = vec![0.0; out_rows * m];
