@@ -111,11 +111,6 @@ fn main() {
         for (col, s) in table.iter_mut().zip(row) {
             col.push(s);
         }
-        let balanced = report
-            .variants
-            .iter()
-            .filter(|v| v.status == Status::Balanced)
-            .count();
         last = vec![(balanced, out)];
     }
     println!(
