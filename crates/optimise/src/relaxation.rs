@@ -125,6 +125,19 @@ struct Feature {
     parts: Vec<(usize, usize, f64)>,
 }
 
+/// Rows of a compressed RMS tail at or below this fraction of its largest row are left out.
+///
+/// Where a torque does not depend on some features (a motor the counterweight's body does not
+/// load) or depends on them only in fixed combinations (a planar arm sees one moment of
+/// inertia), `T` has lower rank than its width, and a column that depends on the columns
+/// before it, with no independent column after it, leaves a row of `R` that holds only the
+/// QR's rounding (1e-17 to 1e-23 of the largest on the palletizer, against 1e-5 and more for a
+/// real row; most motors' tails there shrink from 8 rows to 1–7). Such a row adds a cone
+/// dimension that carries nothing but still costs the solver a row of every factorisation.
+/// Leaving a row out can only shrink the norm, so the cone is a relaxation of the full one and
+/// every bound the search takes from it stays valid.
+pub(crate) const NEGLIGIBLE_TAIL_ROW: f64 = 1e-12;
+
 /// The tail of actuator `a`'s RMS cone on one task: expressions whose Euclidean norm is
 /// `w·‖τ_a‖` over the task's samples.
 ///
@@ -150,7 +163,11 @@ fn rms_tail(task: &TaskTorques, a: usize, w: f64, features: &[Feature]) -> Vec<A
         }
     }
     let rows = if n > width { t.qr().r() } else { t };
+    let largest = (0..rows.nrows())
+        .map(|i| rows.row(i).norm())
+        .fold(0.0f64, f64::max);
     (0..rows.nrows())
+        .filter(|&i| rows.row(i).norm() > NEGLIGIBLE_TAIL_ROW * largest)
         .map(|i| {
             let mut e = Affine::constant(rows[(i, 0)]);
             for (k, f) in features.iter().enumerate() {

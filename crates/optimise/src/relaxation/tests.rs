@@ -124,3 +124,71 @@ fn compressed_rms_tail_has_the_norm_of_the_sampled_torque() {
         }
     }
 }
+
+/// A torque that sees its features only through fewer independent columns than it has
+/// features leaves rows of rounding alone in `R`, and the tail drops them. The features are a
+/// column `s`, a column `s₉` that is zero for actuator 0, and `s` doubled: actuator 0's `T`
+/// is `[base, s, 0, 2s]`, rank 2, and actuator 1's `[base, s, s₉, 2s]`, rank 3 (by
+/// construction), so the tails have 2 and 3 rows, not 4, and keep the norm of the sampled
+/// torque.
+#[test]
+fn a_rank_deficient_rms_tail_keeps_only_its_independent_rows() {
+    let (samples, actuators) = (51, 2);
+    let mut rng = SplitMix64::new(11);
+    let mut uniform = || 2.0 * rng.next_f64() - 1.0;
+    let base: Vec<f64> = (0..samples * actuators).map(|_| 30.0 * uniform()).collect();
+    let mut sensitivity: Vec<Vec<f64>> = (0..BODY_PARAMS)
+        .map(|_| (0..samples * actuators).map(|_| uniform()).collect())
+        .collect();
+    // π 9 loads actuator 1 only.
+    for s in 0..samples {
+        sensitivity[9][s * actuators] = 0.0;
+    }
+    let task = TaskTorques {
+        task: 0,
+        samples,
+        actuators,
+        base,
+        sensitivity,
+    };
+    let features = vec![
+        Feature {
+            expr: Affine::var(0),
+            parts: vec![(0, 2, 1.0)],
+        },
+        Feature {
+            expr: Affine::var(2),
+            parts: vec![(0, 9, 1.0)],
+        },
+        Feature {
+            expr: Affine::var(1).scaled(3.0),
+            parts: vec![(0, 2, 2.0)],
+        },
+    ];
+    let w = 0.5;
+    for (a, rank) in [(0, 2), (1, 3)] {
+        let tail = rms_tail(&task, a, w, &features);
+        assert_eq!(tail.len(), rank, "actuator {a}");
+        for _ in 0..5 {
+            let x = [uniform(), uniform(), uniform()];
+            let direct: f64 = (0..samples)
+                .map(|s| {
+                    let mut tau = task.base[s * actuators + a];
+                    for feat in &features {
+                        let f = feat.expr.eval(&x);
+                        for &(slot, j, c) in &feat.parts {
+                            tau += f * c * task.sens(slot, j)[s * actuators + a];
+                        }
+                    }
+                    (w * tau).powi(2)
+                })
+                .sum::<f64>()
+                .sqrt();
+            let compressed = tail.iter().map(|e| e.eval(&x).powi(2)).sum::<f64>().sqrt();
+            assert!(
+                (compressed - direct).abs() <= 1e-12 * direct,
+                "{compressed} vs {direct}"
+            );
+        }
+    }
+}
