@@ -16,13 +16,11 @@
 //!   the springs realized again at each step (module `polish`);
 //! - **splits** the box at the midpoint of the coordinate that carries the largest relaxation
 //!   error (the spring coupling error `|W − αβ/K|` shared by its two anchor components, times
-//!   their relative widths), or, when the springs' error is negligible, of the widest
+//!   their relative widths; only the part of it that the family cannot remove by moving `W`
+//!   alone, module `coupling`), or, when the springs' error is negligible, of the widest
 //!   counterweight coordinate (springs first while no design is known, or where the relaxed
-//!   point promised a better design but none was realized); where the counterweights come
-//!   first, the best spring split is solved as well and the one that raises the bound more is
-//!   kept (strong branching, product rule); midpoint splits shrink every box,
-//!   so the relaxation converges
-//!   to the true problem and the search terminates;
+//!   point promised a better design but none was realized); midpoint splits shrink every
+//!   box, so the relaxation converges to the true problem and the search terminates;
 //! - **stops** when the best design is within the gap tolerance of the smallest open bound
 //!   (certified optimum), when no box is left (proved impossible), or at the node budget
 //!   (the only undecided outcome, a user-set limit).
@@ -32,12 +30,13 @@
 //! A variant's search in a later pass of the critical-task loop resumes from the boxes the
 //! last one left ([`SearchState`]).
 
+pub(crate) mod coupling;
 pub mod node;
 mod polish;
 
 use std::sync::Arc;
 
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 use crate::clarabel_map::ConicStatus;
 use crate::problem::{CwPhysical, Objective, VariantProblem};
@@ -47,12 +46,15 @@ use crate::refine::{
 use crate::relaxation::RelaxationBase;
 use crate::springs::{Spring, realize_springs};
 use crate::torque::TaskTorques;
+use coupling::coupling_projectors;
 use node::{Coordinate, NodeBox, coordinates};
 
-/// Boxes per variant and pass by default: enough for every variant of the palletizer at
-/// Dmax 2 (the most any needs is about 340), and a bound on the time of the few Dmax 3
-/// variants whose search converges slowly (each box is a conic solve of 5–70 ms).
-pub const DEFAULT_MAX_NODES: usize = 400;
+/// Boxes per variant and pass by default: enough to close every gap of the palletizer at
+/// Dmax 2 and Dmax 3 to the default tolerance (the most one pass needs at Dmax 3 is 2,711, a
+/// counterweight with two springs: eleven branching coordinates), with a third to spare for
+/// other seeds and paths. It bounds the time of a search that converges slowly (a box is a
+/// conic solve of 2–70 ms); only a variant that needs the boxes spends them.
+pub const DEFAULT_MAX_NODES: usize = 4000;
 
 /// Settings of the search.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,10 +68,10 @@ pub struct BranchOptions {
     pub solver_iterations: u32,
 }
 
-/// How many times `max_nodes` a search may spend while it has no design: proving that no design
-/// exists takes more boxes than closing a gap (at Dmax 3 on the palletizer the eight slowest
-/// proofs take 509–885 boxes against at most ~340 for any gap), and an `undecided` verdict is
-/// worth the extra time to avoid.
+/// How many times `max_nodes` a search may spend while it has no design: an `undecided`
+/// verdict is worth the extra time to avoid, and a lower `--max-nodes` (set to trade gaps for
+/// time) should not cut the proofs short with it. At the default limit it is never reached on
+/// the palletizer: the slowest proofs that no design exists take 259–923 boxes at Dmax 3.
 pub const NO_DESIGN_BUDGET_FACTOR: usize = 4;
 
 impl BranchOptions {
@@ -254,7 +256,7 @@ pub(crate) fn bound_box(
 }
 
 /// [`bound_box`] of several boxes (with their orders), solved in parallel on the current rayon
-/// pool: the children of one split, or of two splits under strong branching. Each starts from
+/// pool: the two children of one split. Each starts from
 /// the peak rows `active` marks on entry, and `active` returns every row any of them used; so
 /// the result does not depend on the thread count or on which box finishes first. (A search
 /// on one variant keeps both cores busy where it is the last variant of a pass left running.)
@@ -375,6 +377,7 @@ fn branching_coordinate(
     root: &NodeBox,
     open: &Open,
     counterweights_first: bool,
+    coupled: &[DMatrix<f64>],
 ) -> Option<usize> {
     let relative = |k: usize| {
         let w = open.node.ranges[k][1] - open.node.ranges[k][0];
@@ -389,18 +392,27 @@ fn branching_coordinate(
     if let Some(z) = &open.z {
         let x = problem.lifted(z);
         let mut first = 0;
-        for s in &problem.springs {
+        for (si, s) in problem.springs.iter().enumerate() {
             let (na, nb) = (s.axes_a.len(), s.axes_b.len());
             let kk = x[s.column];
             let unit = kk.abs().max(1e-300)
                 * s.bounds.anchor_a[1].max(1e-3)
                 * s.bounds.anchor_b[1].max(1e-3);
+            let mut errors = DVector::<f64>::zeros(na * nb);
             for i in 0..na {
                 for l in 0..nb {
                     let alpha = x[s.column + 1 + i];
                     let beta = x[s.column + 1 + na + l];
                     let w = x[s.column + 1 + na + nb + i * nb + l];
-                    let error = ((w * kk - alpha * beta) / kk.abs().max(1e-300)).abs() / unit;
+                    errors[i * nb + l] = (w * kk - alpha * beta) / kk.abs().max(1e-300);
+                }
+            }
+            if let Some(p) = coupled.get(si) {
+                errors = p * errors;
+            }
+            for i in 0..na {
+                for l in 0..nb {
+                    let error = errors[i * nb + l].abs() / unit;
                     score[first + i] += error;
                     score[first + na + l] += error;
                 }
@@ -633,6 +645,8 @@ pub fn branch_and_bound(
     // Peak rows found active in any box so far: every later box starts with them.
     let mut active = Vec::new();
     let coords = coordinates(problem);
+    // The part of each spring's coupling error that a split can remove (see `coupling`).
+    let coupled = coupling_projectors(problem);
     let scale = tasks
         .iter()
         .flat_map(|t| t.base.iter())
@@ -803,51 +817,33 @@ pub fn branch_and_bound(
                 let (_, value, _) = merit(problem, tasks, objective, z, scale);
                 value - current.bound > options.gap_tolerance * value.abs()
             });
-        let Some(k) = branching_coordinate(problem, &coords, &root, &current, counterweights_first)
-        else {
+        let Some(k) = branching_coordinate(
+            problem,
+            &coords,
+            &root,
+            &current,
+            counterweights_first,
+            &coupled,
+        ) else {
             stuck.push((current.node, current.bound));
             continue;
         };
-        // Where the counterweights' relaxation is loose, the springs' may be too, and which
-        // split raises the bound more is not known in advance: on the palletizer at Dmax 3,
-        // splitting only the counterweights of m3 + m5 + K42 left its relaxed K42 anchor inside
-        // the anchor's lower norm bound and a 6.4 % gap after 3,200 boxes. So the spring split
-        // is solved too, and the pair of children that raises the bound more is kept (strong
-        // branching; the counterweight split on a tie). Both pairs count as boxes solved.
-        let alternative_split = if counterweights_first {
-            branching_coordinate(problem, &coords, &root, &current, false).filter(|&ks| ks != k)
-        } else {
-            None
-        };
-        let splits: Vec<usize> = std::iter::once(k).chain(alternative_split).collect();
-        let boxes: Vec<(NodeBox, usize)> = splits
-            .iter()
-            .flat_map(|&k| current.node.split(k))
+        // One split, at the coordinate chosen above. Strong branching (solving the best spring
+        // split too where the counterweights come first, and keeping the pair of children whose
+        // rises above the parent bound have the larger product) was the rule until the search
+        // got its budget to close every gap: its choice follows bound rises of the order of the
+        // solver's tolerance, so a change at that level (the tails' negligible rows left out)
+        // sent m3 + m5 + K42 from 82 boxes to over 6,000 at Dmax 3, and over the 117 variants
+        // that take 100 boxes or more it cost 234 CPU s against 189 s for the one split.
+        let boxes: Vec<(NodeBox, usize)> = current
+            .node
+            .split(k)
+            .into_iter()
             .enumerate()
             .map(|(n, child)| (child, child_order(order, n)))
             .collect();
         nodes += boxes.len();
-        let mut solved = bound_boxes(problem, &bases, &mut active, options, boxes, current.bound);
-        let alternative = solved.split_off(2);
-        let mut children = solved;
-        if !alternative.is_empty() {
-            // The product rule of strong branching: each child's rise above the parent bound
-            // (an empty child rises by the parent's magnitude), floored so that a split that
-            // raises one child only still counts.
-            let floor = options.gap_tolerance * 1e-3 * current.bound.abs().max(1e-300);
-            let score = |c: &[Option<Open>]| {
-                c.iter()
-                    .map(|o| {
-                        o.as_ref()
-                            .map_or(current.bound.abs().max(1.0), |o| o.bound - current.bound)
-                            .max(floor)
-                    })
-                    .product::<f64>()
-            };
-            if score(&alternative) > score(&children) {
-                children = alternative;
-            }
-        }
+        let children = bound_boxes(problem, &bases, &mut active, options, boxes, current.bound);
         order += 2;
         for o in children.into_iter().flatten() {
             if closes(o.bound, &best) {
@@ -862,11 +858,9 @@ pub fn branch_and_bound(
 /// The order of the `n`-th child box of a split made when the orders given so far end at
 /// `order` (each split takes two: the loop adds 2 after it). Every child is newer than every
 /// box before the split, so that among tied bounds the search dives into the boxes it just
-/// made; within a split the upper half (`n` odd) is newer than the lower. The children of
-/// strong branching's alternative split (`n` = 2, 3) take the same two orders as the first
-/// pair: only one pair is kept.
+/// made; within a split the upper half (`n` = 1) is newer than the lower (`n` = 0).
 fn child_order(order: usize, n: usize) -> usize {
-    order + 1 + n % 2
+    order + 1 + n
 }
 
 /// The bounds a design must meet, in words, for a certificate: each spring's stiffness and
@@ -950,15 +944,14 @@ mod tests {
     }
 
     /// The search picks the newest of the boxes whose bounds tie: a split's children must be
-    /// newer than every box before it, the upper half newer than the lower, the alternative
-    /// pair numbered as the first, and the next split's children newer than this one's.
+    /// newer than every box before it, the upper half newer than the lower, and the next
+    /// split's children newer than this one's.
     #[test]
     fn children_are_numbered_after_every_box_before_them() {
         for order in [0, 1, 2, 7, 400] {
-            let c: Vec<usize> = (0..4).map(|n| child_order(order, n)).collect();
+            let c: Vec<usize> = (0..2).map(|n| child_order(order, n)).collect();
             assert!(c[0] > order, "order {order}: {c:?}");
             assert!(c[1] > c[0], "order {order}: {c:?}");
-            assert_eq!((c[2], c[3]), (c[0], c[1]), "order {order}");
             assert!(child_order(order + 2, 0) > c[1], "order {order}: {c:?}");
         }
     }

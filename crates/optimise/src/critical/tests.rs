@@ -459,8 +459,8 @@ fn a_search_resumed_on_more_tasks_ends_where_a_fresh_one_does() {
 
 /// The children of a split are solved in parallel (`certify::bound_boxes`), each from the peak
 /// rows known before the split: the search must end with the same bits in a pool of one thread
-/// and of two (the pendulum hybrid splits both its anchors and its counterweight, with strong
-/// branching, over hundreds of boxes).
+/// and of two (the pendulum hybrid splits both its anchors and its counterweight over
+/// hundreds of boxes).
 #[test]
 fn a_search_gives_the_same_bits_on_one_thread_and_on_two() {
     let (_, ctx, variant) = pendulum_m1_k10(5.0, true);
@@ -928,4 +928,42 @@ fn the_final_reaction_solve_follows_the_study_size() {
         OptimiseOptions::default().final_reaction_solve,
         FinalReactionSolve::Operator
     );
+}
+
+/// The part of a spring's coupling error a split must remove (`certify::coupling`), from the
+/// palletizer's geometry (`docs/palletizer.md`). K54 joins upper_arm and front_link, which both
+/// turn by θ3: `a·R(0)·b` is constant, so W never enters the energy and every error is free
+/// (projector 0). K42 joins upper_arm (turning by θ3) to slider_h (not turning): only
+/// `a·R(θ3)·b = cos θ3 (W11 + W22) + sin θ3 (W12 − W21)` enters, so where balance leaves the
+/// anchors unrestricted (m3 + m5 + K42) the projector is the one onto those two combinations,
+/// ½[[1,0,0,1],[0,1,−1,0],[0,−1,1,0],[1,0,0,1]] in W's row-major order; where the balance
+/// search fixes K42's anchor components (m4 + K42 + K54 pins W11 = W21 = 0) nothing is free.
+#[test]
+fn the_coupling_error_a_split_removes_follows_the_members_rotations() {
+    use crate::certify::coupling::coupling_projectors;
+    let model = palletizer_dmax3();
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let projectors = |labels: &[&str]| {
+        let run = new_run(&ctx, &balanced_variant(&model, labels), &options);
+        coupling_projectors(run.problem.as_ref().unwrap())
+    };
+    let close = |p: &nalgebra::DMatrix<f64>, q: &nalgebra::DMatrix<f64>| (p - q).amax() <= 1e-9;
+    let identity = nalgebra::DMatrix::<f64>::identity(4, 4);
+    let pinned = projectors(&["m4", "K42", "K54"]);
+    assert!(close(&pinned[0], &identity), "K42: {}", pinned[0]);
+    assert!(
+        close(&pinned[1], &nalgebra::DMatrix::zeros(4, 4)),
+        "K54: {}",
+        pinned[1]
+    );
+    let rotating = projectors(&["m3", "m5", "K42"]);
+    #[rustfmt::skip]
+    let expected = nalgebra::DMatrix::from_row_slice(4, 4, &[
+        0.5, 0.0, 0.0, 0.5,
+        0.0, 0.5, -0.5, 0.0,
+        0.0, -0.5, 0.5, 0.0,
+        0.5, 0.0, 0.0, 0.5,
+    ]);
+    assert!(close(&rotating[0], &expected), "K42: {}", rotating[0]);
 }
