@@ -166,7 +166,7 @@ fn rms_tail(task: &TaskTorques, a: usize, w: f64, features: &[Feature]) -> Vec<A
     let largest = (0..rows.nrows())
         .map(|i| rows.row(i).norm())
         .fold(0.0f64, f64::max);
-    (0..rows.nrows())
+    let tail: Vec<Affine> = (0..rows.nrows())
         .filter(|&i| rows.row(i).norm() > NEGLIGIBLE_TAIL_ROW * largest)
         .map(|i| {
             let mut e = Affine::constant(rows[(i, 0)]);
@@ -178,7 +178,12 @@ fn rms_tail(task: &TaskTorques, a: usize, w: f64, features: &[Feature]) -> Vec<A
             }
             e
         })
-        .collect()
+        .collect();
+    if tail.is_empty() {
+        // A motor that no sample loads: one zero row keeps the cone `t ≥ 0` a proper one.
+        return vec![Affine::constant(0.0)];
+    }
+    tail
 }
 
 /// Builds and solves the relaxation on the working-set tasks.

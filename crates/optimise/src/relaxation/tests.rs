@@ -165,10 +165,16 @@ fn a_rank_deficient_rms_tail_keeps_only_its_independent_rows() {
             parts: vec![(0, 2, 2.0)],
         },
     ];
-    let w = 0.5;
-    for (a, rank) in [(0, 2), (1, 3)] {
+    // The rows dropped are negligible against the largest at any scale of the torque.
+    for (a, rank, w) in [
+        (0, 2, 0.5),
+        (1, 3, 0.5),
+        (0, 2, 1e6),
+        (1, 3, 1e6),
+        (1, 3, 1e-6),
+    ] {
         let tail = rms_tail(&task, a, w, &features);
-        assert_eq!(tail.len(), rank, "actuator {a}");
+        assert_eq!(tail.len(), rank, "actuator {a}, weight {w}");
         for _ in 0..5 {
             let x = [uniform(), uniform(), uniform()];
             let direct: f64 = (0..samples)
@@ -191,4 +197,25 @@ fn a_rank_deficient_rms_tail_keeps_only_its_independent_rows() {
             );
         }
     }
+}
+
+/// A motor that no sample loads (zero base torque, zero sensitivities) keeps one zero row, so
+/// its cone stays `t ≥ |0|`, as with the full tail of zeros, not a cone of dimension one.
+#[test]
+fn an_unloaded_motor_keeps_one_zero_row() {
+    let (samples, actuators) = (51, 1);
+    let task = TaskTorques {
+        task: 0,
+        samples,
+        actuators,
+        base: vec![0.0; samples],
+        sensitivity: vec![vec![0.0; samples]; BODY_PARAMS],
+    };
+    let features = vec![Feature {
+        expr: Affine::var(0),
+        parts: vec![(0, 1, 1.0)],
+    }];
+    let tail = rms_tail(&task, 0, 1.0, &features);
+    assert_eq!(tail.len(), 1);
+    assert_eq!(tail[0].eval(&[3.0]), 0.0);
 }
