@@ -99,7 +99,7 @@ mod tests {
     fn mixed_family(scale: f64, weak: f64) -> DMatrix<f64> {
         // Rows: other 0, other 1, W11, W12, W21, W22, other 6.
         let u = [1.0, -2.0, 1.0, 2.0, -2.0, 1.0, 0.5];
-        let v = [weak, 0.0, 1.0, 0.0, 0.0, -1.0, 0.0];
+        let v = [0.0, 0.0, 1.0, 0.0, 0.0, -1.0, weak];
         let w = [0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0];
         DMatrix::from_fn(7, 3, |r, c| {
             scale
@@ -120,8 +120,8 @@ mod tests {
     }
 
     /// A direction that moves another row a little is not private: with `v` also moving row
-    /// 0 by 1e-5 of its `W` part, only `w` is free, and the projector is the identity less
-    /// the projector onto `(0, 1, 1, 0)/√2`.
+    /// 6 (after the block) by 1e-5 of its `W` part, only `w` is free, and the projector is the
+    /// identity less the projector onto `(0, 1, 1, 0)/√2`.
     #[test]
     fn a_weak_coupling_to_another_row_is_still_a_coupling() {
         let p = projector_off_private(&mixed_family(1.0, 1e-5), 2, 4);

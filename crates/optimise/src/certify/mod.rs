@@ -256,8 +256,8 @@ pub(crate) fn bound_box(
 }
 
 /// [`bound_box`] of several boxes (with their orders), solved in parallel on the current rayon
-/// pool: the two children of one split. Each starts from
-/// the peak rows `active` marks on entry, and `active` returns every row any of them used; so
+/// pool: the two children of one split. Each starts from the peak rows `active` marks on
+/// entry, and `active` returns every row any of them used; so
 /// the result does not depend on the thread count or on which box finishes first. (A search
 /// on one variant keeps both cores busy where it is the last variant of a pass left running.)
 pub(crate) fn bound_boxes(
@@ -645,7 +645,7 @@ pub fn branch_and_bound(
     // Peak rows found active in any box so far: every later box starts with them.
     let mut active = Vec::new();
     let coords = coordinates(problem);
-    // The part of each spring's coupling error that a split can remove (see `coupling`).
+    // Per spring, the projector onto the coupling error only a split can remove (`coupling`).
     let coupled = coupling_projectors(problem);
     let scale = tasks
         .iter()

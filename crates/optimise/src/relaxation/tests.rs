@@ -58,6 +58,37 @@ fn lazy_peak_rows_reach_the_full_problems_optimum() {
     }
 }
 
+/// The compressed tail's norm at the conic point `x` against `w·‖τ_a‖` over the task's
+/// samples, τ computed directly from the base torque and the sensitivities, to 1e-12.
+fn assert_tail_has_the_sampled_norm(
+    task: &TaskTorques,
+    a: usize,
+    w: f64,
+    features: &[Feature],
+    tail: &[Affine],
+    x: &[f64],
+) {
+    let na = task.actuators;
+    let direct: f64 = (0..task.samples)
+        .map(|s| {
+            let mut tau = task.base[s * na + a];
+            for feat in features {
+                let f = feat.expr.eval(x);
+                for &(slot, j, c) in &feat.parts {
+                    tau += f * c * task.sens(slot, j)[s * na + a];
+                }
+            }
+            (w * tau).powi(2)
+        })
+        .sum::<f64>()
+        .sqrt();
+    let compressed = tail.iter().map(|e| e.eval(x).powi(2)).sum::<f64>().sqrt();
+    assert!(
+        (compressed - direct).abs() <= 1e-12 * direct,
+        "{compressed} vs {direct}"
+    );
+}
+
 /// `rms_tail` against the sample-by-sample norm it replaces: for random feature values the
 /// norm of the compressed rows equals `w·‖τ‖` over the samples, τ computed directly from
 /// the base torque and the sensitivities.
@@ -103,24 +134,7 @@ fn compressed_rms_tail_has_the_norm_of_the_sampled_torque() {
         assert_eq!(tail.len(), 1 + features.len());
         for _ in 0..5 {
             let x = [uniform(), uniform()];
-            let f: Vec<f64> = features.iter().map(|f| f.expr.eval(&x)).collect();
-            let direct: f64 = (0..samples)
-                .map(|s| {
-                    let mut tau = task.base[s * actuators + a];
-                    for (k, feat) in features.iter().enumerate() {
-                        for &(slot, j, c) in &feat.parts {
-                            tau += f[k] * c * task.sens(slot, j)[s * actuators + a];
-                        }
-                    }
-                    (w * tau).powi(2)
-                })
-                .sum::<f64>()
-                .sqrt();
-            let compressed = tail.iter().map(|e| e.eval(&x).powi(2)).sum::<f64>().sqrt();
-            assert!(
-                (compressed - direct).abs() <= 1e-12 * direct,
-                "{compressed} vs {direct}"
-            );
+            assert_tail_has_the_sampled_norm(&task, a, w, &features, &tail, &x);
         }
     }
 }
@@ -177,24 +191,7 @@ fn a_rank_deficient_rms_tail_keeps_only_its_independent_rows() {
         assert_eq!(tail.len(), rank, "actuator {a}, weight {w}");
         for _ in 0..5 {
             let x = [uniform(), uniform(), uniform()];
-            let direct: f64 = (0..samples)
-                .map(|s| {
-                    let mut tau = task.base[s * actuators + a];
-                    for feat in &features {
-                        let f = feat.expr.eval(&x);
-                        for &(slot, j, c) in &feat.parts {
-                            tau += f * c * task.sens(slot, j)[s * actuators + a];
-                        }
-                    }
-                    (w * tau).powi(2)
-                })
-                .sum::<f64>()
-                .sqrt();
-            let compressed = tail.iter().map(|e| e.eval(&x).powi(2)).sum::<f64>().sqrt();
-            assert!(
-                (compressed - direct).abs() <= 1e-12 * direct,
-                "{compressed} vs {direct}"
-            );
+            assert_tail_has_the_sampled_norm(&task, a, w, &features, &tail, &x);
         }
     }
 }
