@@ -392,7 +392,7 @@ fn branching_coordinate(
     if let Some(z) = &open.z {
         let x = problem.lifted(z);
         let mut first = 0;
-        for (si, s) in problem.springs.iter().enumerate() {
+        for (s, projector) in problem.springs.iter().zip(coupled) {
             let (na, nb) = (s.axes_a.len(), s.axes_b.len());
             let kk = x[s.column];
             let unit = kk.abs().max(1e-300)
@@ -407,9 +407,7 @@ fn branching_coordinate(
                     errors[i * nb + l] = (w * kk - alpha * beta) / kk.abs().max(1e-300);
                 }
             }
-            if let Some(p) = coupled.get(si) {
-                errors = p * errors;
-            }
+            let errors = projector * errors;
             for i in 0..na {
                 for l in 0..nb {
                     let error = errors[i * nb + l].abs() / unit;

@@ -58,6 +58,24 @@ fn lazy_peak_rows_reach_the_full_problems_optimum() {
     }
 }
 
+/// A task of 51 samples for `actuators` motors and one slot: base torques uniform in ±30 N·m,
+/// sensitivities uniform in ±1, drawn from `rng` in that order.
+fn random_task(rng: &mut SplitMix64, actuators: usize) -> TaskTorques {
+    let samples = 51;
+    let mut uniform = || 2.0 * rng.next_f64() - 1.0;
+    let base: Vec<f64> = (0..samples * actuators).map(|_| 30.0 * uniform()).collect();
+    let sensitivity: Vec<Vec<f64>> = (0..BODY_PARAMS)
+        .map(|_| (0..samples * actuators).map(|_| uniform()).collect())
+        .collect();
+    TaskTorques {
+        task: 0,
+        samples,
+        actuators,
+        base,
+        sensitivity,
+    }
+}
+
 /// The compressed tail's norm at the conic point `x` against `w·‖τ_a‖` over the task's
 /// samples, τ computed directly from the base torque and the sensitivities, to 1e-12.
 fn assert_tail_has_the_sampled_norm(
@@ -94,20 +112,10 @@ fn assert_tail_has_the_sampled_norm(
 /// the base torque and the sensitivities.
 #[test]
 fn compressed_rms_tail_has_the_norm_of_the_sampled_torque() {
-    let (samples, actuators, slots) = (51, 3, 1);
+    let actuators = 3;
     let mut rng = SplitMix64::new(7);
+    let task = random_task(&mut rng, actuators);
     let mut uniform = || 2.0 * rng.next_f64() - 1.0;
-    let base: Vec<f64> = (0..samples * actuators).map(|_| 30.0 * uniform()).collect();
-    let sensitivity: Vec<Vec<f64>> = (0..slots * BODY_PARAMS)
-        .map(|_| (0..samples * actuators).map(|_| uniform()).collect())
-        .collect();
-    let task = TaskTorques {
-        task: 0,
-        samples,
-        actuators,
-        base,
-        sensitivity,
-    };
     // Three features over two conic variables: m, μ_x (parts on π 0 and 1) and a mixed one.
     let features = vec![
         Feature {
@@ -147,24 +155,14 @@ fn compressed_rms_tail_has_the_norm_of_the_sampled_torque() {
 /// torque.
 #[test]
 fn a_rank_deficient_rms_tail_keeps_only_its_independent_rows() {
-    let (samples, actuators) = (51, 2);
+    let actuators = 2;
     let mut rng = SplitMix64::new(11);
-    let mut uniform = || 2.0 * rng.next_f64() - 1.0;
-    let base: Vec<f64> = (0..samples * actuators).map(|_| 30.0 * uniform()).collect();
-    let mut sensitivity: Vec<Vec<f64>> = (0..BODY_PARAMS)
-        .map(|_| (0..samples * actuators).map(|_| uniform()).collect())
-        .collect();
+    let mut task = random_task(&mut rng, actuators);
     // π 9 loads actuator 1 only.
-    for s in 0..samples {
-        sensitivity[9][s * actuators] = 0.0;
+    for s in 0..task.samples {
+        task.sensitivity[9][s * actuators] = 0.0;
     }
-    let task = TaskTorques {
-        task: 0,
-        samples,
-        actuators,
-        base,
-        sensitivity,
-    };
+    let mut uniform = || 2.0 * rng.next_f64() - 1.0;
     let features = vec![
         Feature {
             expr: Affine::var(0),
