@@ -214,3 +214,90 @@ fn an_unloaded_motor_keeps_one_zero_row() {
     assert_eq!(tail.len(), 1);
     assert_eq!(tail[0].eval(&[3.0]), 0.0);
 }
+
+/// The tangents of `m^{5/3}` that replace the power cone, through the conic rows the
+/// relaxation adds: minimising `p'` at a fixed mass gives the highest tangent there, which must
+/// lie below the curve (the relaxation stays valid) and within the gap the tangent ratio allows.
+/// That gap is derived apart: between tangents at `t` and `1.5·t` the largest relative distance
+/// to the curve is 0.02247 (a sweep of the two closed-form tangents, `t^{5/3} + (5/3)·t^{2/3}·
+/// (m − t)`, over `[t, 1.5·t]`; it does not depend on `t` since the curve is homogeneous).
+#[test]
+fn the_tangents_of_the_cylinder_inertia_lie_below_it_within_the_ratios_gap() {
+    let five_thirds = |m: f64| m.powf(5.0 / 3.0);
+    // The gap at the ratio, from the closed-form tangents.
+    let q = TANGENT_RATIO;
+    let tangent = |t: f64, m: f64| five_thirds(t) + (5.0 / 3.0) * t.powf(2.0 / 3.0) * (m - t);
+    let swept = (0..=10_000)
+        .map(|i| 1.0 + (q - 1.0) * i as f64 / 10_000.0)
+        .map(|m| 1.0 - tangent(1.0, m).max(tangent(q, m)) / five_thirds(m))
+        .fold(0.0f64, f64::max);
+    assert!((swept - 0.02247).abs() < 5e-5, "{swept}");
+    for (lo, hi) in [
+        (1.0, 100.0),
+        (5e-4, 500.0),
+        (30.0, 40.0),
+        (0.0, 12.0),
+        (7.0, 7.0),
+    ] {
+        let points = tangent_points(lo, hi);
+        let floor = lo.max(1e-3 * hi);
+        assert_eq!(*points.last().unwrap(), hi, "[{lo}, {hi}]");
+        let geometric: Vec<f64> = points.iter().copied().filter(|&t| t >= floor).collect();
+        assert!(
+            (geometric[0] - floor).abs() <= 1e-12 * floor,
+            "[{lo}, {hi}]: {points:?}"
+        );
+        for w in geometric.windows(2) {
+            assert!(
+                w[1] > w[0] && w[1] / w[0] <= q * (1.0 + 1e-12),
+                "{points:?}"
+            );
+        }
+        // Below the floor, only the lower bound itself (when positive).
+        let below: Vec<f64> = points.iter().copied().filter(|&t| t < floor).collect();
+        assert_eq!(
+            below,
+            if lo > 0.0 && lo < floor {
+                vec![lo]
+            } else {
+                vec![]
+            }
+        );
+        // Through the conic rows, with a natural mass scale that is not the bound.
+        let big_m = 0.7 * hi;
+        for i in 0..=40 {
+            let m = floor + (hi - floor) * i as f64 / 40.0;
+            let mut cp = ConicProblem::default();
+            let mn = cp.new_variable();
+            let p = cp.new_variable();
+            cp.objective[p] = 1.0;
+            let mut at = Affine::var(mn);
+            at.constant -= m / big_m;
+            cp.nonneg(&at);
+            cp.nonneg(&at.scaled(-1.0));
+            cp.nonneg(&Affine::var(p));
+            for &t in &points {
+                below_five_thirds_tangent(&mut cp, p, &Affine::var(mn), big_m, t);
+            }
+            let solution = cp.solve(200);
+            assert_eq!(solution.status, ConicStatus::Solved);
+            let relaxed = solution.x[p] * five_thirds(big_m);
+            let highest = points.iter().map(|&t| tangent(t, m)).fold(0.0f64, f64::max);
+            // clarabel's absolute tolerance (1e-8) on the normalised p' = p/M^{5/3}.
+            let tol = 1e-7 * five_thirds(big_m);
+            assert!(
+                (relaxed - highest).abs() <= tol,
+                "m = {m}: {relaxed} vs {highest}"
+            );
+            assert!(
+                relaxed <= five_thirds(m) + tol,
+                "m = {m}: {relaxed} above the curve"
+            );
+            assert!(
+                relaxed >= (1.0 - 0.02247) * five_thirds(m) - tol,
+                "m = {m}: {relaxed} against {}",
+                five_thirds(m)
+            );
+        }
+    }
+}
