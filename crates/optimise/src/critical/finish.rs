@@ -270,9 +270,10 @@ pub(super) fn spring_options(
 
 /// The spring choice of every run, in run order: per run the option with the lowest ΔR on its
 /// reaction tasks (see [`lowest_delta_r`]). The options are realized run by run in parallel;
-/// their reactions are then evaluated in one batch over all the runs' tasks
-/// ([`batched_reaction_peaks`], the same bits as run by run). `tick` is called once per run as
-/// its choice is known; the time of the reactions is added to `reactions_time`.
+/// their reactions are then evaluated in batches over all the runs' tasks, leaving out the
+/// options that cannot be the lowest ([`lowest_delta_r_choices`]: the same choice and bits as
+/// every option run by run). `tick` is called once per run as its choice is known; the time of
+/// the reactions is added to `reactions_time`.
 pub(super) fn spring_choices(
     ctx: &Context,
     runs: &[Run],
@@ -301,30 +302,18 @@ pub(super) fn spring_choices(
         })
         .collect();
     let started = Stopwatch::start();
-    let mut peaks = batched_reaction_peaks(ctx, &groups).into_iter();
+    let mut choices = lowest_delta_r_choices(ctx, &groups).into_iter();
     *reactions_time += started.elapsed();
     prepared
         .into_iter()
         .map(|o| match o {
             SpringOptions::Nothing => None,
             SpringOptions::NoSprings(x) => Some((Vec::new(), x, None)),
-            SpringOptions::Options {
-                mut found,
-                variants,
-                ..
-            } => {
-                let peaks = peaks.next().expect("one result per group");
-                let scores: Vec<Option<f64>> = match &peaks {
-                    Some(p) => p
-                        .iter()
-                        .map(|(f, m)| delta_r(&ctx.unbalanced, f, m))
-                        .collect(),
-                    None => vec![None; variants.len()],
-                };
-                let best = lowest_delta_r(&scores).unwrap_or(0);
+            SpringOptions::Options { mut found, .. } => {
+                let (best, score) = choices.next().expect("one choice per group");
                 let (s, x) = found.swap_remove(best);
                 tick();
-                Some((s, x, scores[best]))
+                Some((s, x, score))
             }
         })
         .collect()

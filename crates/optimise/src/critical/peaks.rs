@@ -113,6 +113,209 @@ pub(super) fn batched_reaction_peaks(
     total.into_iter().map(Some).collect()
 }
 
+/// Per group, the option with the lowest ΔR on the group's tasks and that ΔR: what
+/// [`lowest_delta_r`] picks from every option's score over [`batched_reaction_peaks`] (the same
+/// index and the same bits), without evaluating every option on every task.
+///
+/// A spring choice holds about thirty options per run. ΔR only grows with each joint's peak
+/// (its terms are `γ·max(0, ΔF)` and alike), and a peak over some tasks is at most the peak
+/// over all, so ΔR over a subset of the tasks is a lower bound of an option's ΔR. Four batched
+/// rounds: the first option of each group on every task, one task at a time; the other options
+/// on the [`PROBE_TASKS`] tasks where the first one's ΔR alone is largest (lower bounds); the
+/// option with the lowest bound on the other tasks; and on those, every option whose bound
+/// could still beat the best ΔR known (ties go to the earlier option, as in
+/// [`lowest_delta_r`]). An option left out has a ΔR that cannot be the lowest, and every option
+/// evaluated in full has the maximum over the same per-task peaks (a column's reactions do not
+/// depend on its batch) as in one pass. A group whose first round fails (no evaluator, a task
+/// whose kinematics fail for the first option) is evaluated in full.
+pub(super) fn lowest_delta_r_choices(
+    ctx: &Context,
+    groups: &[(&[Variant], &[usize])],
+) -> Vec<(usize, Option<f64>)> {
+    let score = |peaks: &JointPeaks| delta_r(&ctx.unbalanced, &peaks.0, &peaks.1);
+    // (ΔR, index) in the order of `lowest_delta_r`: no score last, ties to the earlier option.
+    let key = |s: Option<f64>, i: usize| (s.unwrap_or(f64::INFINITY), i);
+    let before = |a: (f64, usize), b: (f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).is_lt();
+    let n = groups.len();
+    // Round 1: the first option, task by task.
+    let requests: Vec<(&[Variant], &[usize])> = groups
+        .iter()
+        .flat_map(|(variants, tasks)| {
+            tasks
+                .iter()
+                .map(move |w| (&variants[..variants.len().min(1)], std::slice::from_ref(w)))
+        })
+        .collect();
+    let mut per_task = batched_reaction_peaks(ctx, &requests).into_iter();
+    let mut full = vec![false; n];
+    let mut first: Vec<(JointPeaks, Option<f64>)> = Vec::with_capacity(n);
+    let mut probes: Vec<Vec<usize>> = Vec::with_capacity(n);
+    let mut rests: Vec<Vec<usize>> = Vec::with_capacity(n);
+    for (g, (variants, tasks)) in groups.iter().enumerate() {
+        let peaks: Vec<Option<JointPeaks>> = tasks
+            .iter()
+            .map(|_| {
+                per_task
+                    .next()
+                    .expect("one result per request")
+                    .and_then(|mut p| p.pop())
+            })
+            .collect();
+        full[g] = variants.is_empty() || peaks.iter().any(Option::is_none);
+        let peaks: Vec<JointPeaks> = peaks.into_iter().flatten().collect();
+        let mut total = zero_peaks(ctx, 1);
+        for p in &peaks {
+            raise_peaks(&mut total, vec![p.clone()]);
+        }
+        let total = total.pop().expect("one column");
+        // The tasks where the first option's ΔR alone is largest.
+        let mut ranked: Vec<(f64, usize)> = peaks
+            .iter()
+            .zip(tasks.iter())
+            .map(|(p, &w)| (score(p).unwrap_or(f64::INFINITY), w))
+            .collect();
+        ranked.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let probe: Vec<usize> = ranked.iter().take(PROBE_TASKS).map(|r| r.1).collect();
+        rests.push(
+            tasks
+                .iter()
+                .copied()
+                .filter(|w| !probe.contains(w))
+                .collect(),
+        );
+        probes.push(probe);
+        let s = score(&total);
+        first.push((total, s));
+    }
+    // Round 2: the other options on the probe tasks: lower bounds.
+    let requests: Vec<(&[Variant], &[usize])> = (0..n)
+        .map(|g| {
+            let variants = groups[g].0;
+            if full[g] {
+                (&variants[..0], &probes[g][..0])
+            } else {
+                (&variants[1..], &probes[g][..])
+            }
+        })
+        .collect();
+    let partial: Vec<Option<Vec<JointPeaks>>> = batched_reaction_peaks(ctx, &requests);
+    let lower: Vec<Vec<Option<f64>>> = (0..n)
+        .map(|g| match &partial[g] {
+            Some(p) if !full[g] => p.iter().map(score).collect(),
+            _ => {
+                full[g] = true;
+                Vec::new()
+            }
+        })
+        .collect();
+    // Evaluates `chosen` options of each group on its other tasks: their ΔR.
+    let finish = |chosen: &[Vec<usize>]| -> Vec<Vec<Option<f64>>> {
+        let variants: Vec<Vec<Variant>> = (0..n)
+            .map(|g| chosen[g].iter().map(|&i| groups[g].0[i].clone()).collect())
+            .collect();
+        let requests: Vec<(&[Variant], &[usize])> =
+            (0..n).map(|g| (&variants[g][..], &rests[g][..])).collect();
+        let rest = batched_reaction_peaks(ctx, &requests);
+        (0..n)
+            .map(|g| {
+                chosen[g]
+                    .iter()
+                    .enumerate()
+                    .map(|(c, &i)| {
+                        let mut total = vec![partial[g].as_ref().expect("not full")[i - 1].clone()];
+                        match rest[g].as_ref() {
+                            Some(r) => raise_peaks(&mut total, vec![r[c].clone()]),
+                            None => return None,
+                        }
+                        score(&total[0])
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    // Round 3: the option with the lowest bound, where it could beat the first.
+    let leaders: Vec<Vec<usize>> = (0..n)
+        .map(|g| {
+            if full[g] {
+                return Vec::new();
+            }
+            (0..lower[g].len())
+                .map(|k| (key(lower[g][k], k + 1), k + 1))
+                .filter(|(b, _)| before(*b, key(first[g].1, 0)))
+                .min_by(|a, b| a.0.0.total_cmp(&b.0.0).then(a.1.cmp(&b.1)))
+                .map(|(_, i)| vec![i])
+                .unwrap_or_default()
+        })
+        .collect();
+    let leader_scores = finish(&leaders);
+    // Round 4: every other option whose bound could still beat the best ΔR known.
+    let best_known: Vec<(f64, usize)> = (0..n)
+        .map(|g| {
+            let mut best = key(first[g].1, 0);
+            for (&i, &s) in leaders[g].iter().zip(&leader_scores[g]) {
+                if before(key(s, i), best) {
+                    best = key(s, i);
+                }
+            }
+            best
+        })
+        .collect();
+    let others: Vec<Vec<usize>> = (0..n)
+        .map(|g| {
+            if full[g] {
+                return Vec::new();
+            }
+            (1..=lower[g].len())
+                .filter(|i| !leaders[g].contains(i))
+                .filter(|&i| {
+                    lower[g][i - 1].is_none() || before(key(lower[g][i - 1], i), best_known[g])
+                })
+                .collect()
+        })
+        .collect();
+    let other_scores = finish(&others);
+    let fallback: Vec<(&[Variant], &[usize])> =
+        (0..n).filter(|&g| full[g]).map(|g| groups[g]).collect();
+    let mut fallback = batched_reaction_peaks(ctx, &fallback).into_iter();
+    (0..n)
+        .map(|g| {
+            let scores: Vec<(usize, Option<f64>)> = if full[g] {
+                match fallback.next().flatten() {
+                    Some(peaks) => peaks.iter().map(score).enumerate().collect(),
+                    None => (0..groups[g].0.len()).map(|i| (i, None)).collect(),
+                }
+            } else {
+                std::iter::once((0, first[g].1))
+                    .chain(
+                        leaders[g]
+                            .iter()
+                            .copied()
+                            .zip(leader_scores[g].iter().copied()),
+                    )
+                    .chain(
+                        others[g]
+                            .iter()
+                            .copied()
+                            .zip(other_scores[g].iter().copied()),
+                    )
+                    .collect()
+            };
+            scores
+                .iter()
+                .copied()
+                .min_by(|a, b| {
+                    let (ka, kb) = (key(a.1, a.0), key(b.1, b.0));
+                    ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1))
+                })
+                .unwrap_or((0, None))
+        })
+        .collect()
+}
+
+/// Tasks on which every spring option is evaluated before the options that cannot be the
+/// lowest ΔR are left out (see [`lowest_delta_r_choices`]).
+const PROBE_TASKS: usize = 2;
+
 /// Zero peaks for `columns` columns.
 pub(super) fn zero_peaks(ctx: &Context, columns: usize) -> Vec<JointPeaks> {
     let nj = ctx.model.joints.len();

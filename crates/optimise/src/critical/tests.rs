@@ -4,7 +4,7 @@
 //! free coordinates, and from a second evaluation of the joint reactions through the dynamics
 //! crate's grid tables.
 
-use super::peaks::{batched_reaction_peaks, reaction_peaks};
+use super::peaks::{batched_reaction_peaks, lowest_delta_r_choices, reaction_peaks};
 use super::*;
 use crate::result::{FreeParameter, Status};
 use crate::springs::realize_springs;
@@ -1036,4 +1036,82 @@ fn the_boxes_tangent_relaxation_bounds_below_the_power_cones_within_the_gap() {
         largest_loss <= 0.2 * options.gap_tolerance,
         "the tangents give up {largest_loss:.2e} of a box's bound"
     );
+}
+
+/// The spring choice leaves out options that cannot have the lowest ΔR; its choice must be
+/// the one every option evaluated on every task gives ([`batched_reaction_peaks`], then
+/// [`lowest_delta_r`]), the same index and the same bits. Groups of spring options on the
+/// palletizer's reaction tasks: stiffnesses and anchors spread so that the best is sometimes
+/// the first option and sometimes a later one, and repeated options, whose tie must go to the
+/// earlier.
+#[test]
+fn the_spring_choice_without_hopeless_options_is_the_choice_over_all() {
+    let model = model(&case_json("palletizer.json"));
+    let ctx = Context::new(&model, None).unwrap();
+    let name = |body: usize| model.bodies[body].name.clone();
+    let spring =
+        |body: usize, other: Option<usize>, stiffness: f64, a: [f64; 2], b: [f64; 2]| Spring {
+            label: "K".into(),
+            body: name(body),
+            other: other.map_or_else(|| "base".into(), name),
+            stiffness,
+            anchor_a: [a[0], a[1], 0.0],
+            anchor_b: [b[0], b[1], 0.0],
+            plane: None,
+        };
+    let mut rng = counterpoise_model::sampling::SplitMix64::new(29);
+    let mut option = |body: usize, other: Option<usize>| {
+        let mut u = || 2.0 * rng.next_f64() - 1.0;
+        Variant {
+            counterweights: vec![],
+            springs: vec![spring(
+                body,
+                other,
+                3000.0 * (1.5 + u()),
+                [0.3 * u(), 0.3 * u()],
+                [0.4 * u(), 0.4 * u()],
+            )],
+        }
+    };
+    let mut groups_owned: Vec<Vec<Variant>> = Vec::new();
+    for (body, other) in [(4, None), (5, Some(3)), (6, Some(4)), (3, None), (5, None)] {
+        groups_owned.push((0..12).map(|_| option(body, other)).collect());
+    }
+    // Ties: the same option twice, after a worse one and first.
+    let (x, y) = (option(4, None), option(4, None));
+    groups_owned.push(vec![x.clone(), y.clone(), x.clone(), y.clone()]);
+    groups_owned.push(vec![y.clone(), x.clone(), x, y]);
+    let mut tasks: BTreeSet<usize> = BTreeSet::new();
+    for j in &ctx.unbalanced.joints {
+        tasks.extend(ctx.task_index(j.force_task));
+        tasks.extend(ctx.task_index(j.moment_task));
+    }
+    let n = ctx.tasks.len();
+    tasks.extend([3, n / 4, n / 2, n - 2]);
+    let tasks: Vec<usize> = tasks.into_iter().collect();
+    let groups: Vec<(&[Variant], &[usize])> =
+        groups_owned.iter().map(|g| (&g[..], &tasks[..])).collect();
+    let choices = lowest_delta_r_choices(&ctx, &groups);
+    let every = batched_reaction_peaks(&ctx, &groups);
+    let mut later = 0;
+    for (g, (choice, peaks)) in choices.iter().zip(&every).enumerate() {
+        let scores: Vec<Option<f64>> = peaks
+            .as_ref()
+            .unwrap()
+            .iter()
+            .map(|(f, m)| delta_r(&ctx.unbalanced, f, m))
+            .collect();
+        let best = lowest_delta_r(&scores).unwrap();
+        assert_eq!(choice.0, best, "group {g}: {scores:?}");
+        assert_eq!(choice.1.map(f64::to_bits), scores[best].map(f64::to_bits));
+        later += usize::from(best > 0);
+    }
+    // Both kinds of groups, and the ties to the earlier of two equal options.
+    assert!(
+        later >= 2 && later < choices.len(),
+        "{later} of {}",
+        choices.len()
+    );
+    assert!(choices[choices.len() - 2].0 <= 1);
+    assert!(choices[choices.len() - 1].0 <= 1);
 }
