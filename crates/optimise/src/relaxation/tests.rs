@@ -232,6 +232,9 @@ fn the_tangents_of_the_cylinder_inertia_lie_below_it_within_the_ratios_gap() {
         .map(|m| 1.0 - tangent(1.0, m).max(tangent(q, m)) / five_thirds(m))
         .fold(0.0f64, f64::max);
     assert!((swept - 0.02247).abs() < 5e-5, "{swept}");
+    // No tangent without a positive, finite upper bound.
+    assert!(tangent_points(0.0, 0.0).is_empty());
+    assert!(tangent_points(1.0, f64::INFINITY).is_empty());
     for (lo, hi) in [
         (1.0, 100.0),
         (5e-4, 500.0),
