@@ -242,7 +242,7 @@ pub(super) fn lowest_delta_r_choices(
             (0..lower[g].len())
                 .map(|k| (key(lower[g][k], k + 1), k + 1))
                 .filter(|(b, _)| before(*b, key(first[g].1, 0)))
-                .min_by(|a, b| a.0.0.total_cmp(&b.0.0).then(a.1.cmp(&b.1)))
+                .reduce(|a, b| if before(b.0, a.0) { b } else { a })
                 .map(|(_, i)| vec![i])
                 .unwrap_or_default()
         })
@@ -300,14 +300,12 @@ pub(super) fn lowest_delta_r_choices(
                     )
                     .collect()
             };
-            scores
-                .iter()
-                .copied()
-                .min_by(|a, b| {
-                    let (ka, kb) = (key(a.1, a.0), key(b.1, b.0));
-                    ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1))
-                })
-                .unwrap_or((0, None))
+            // The choice itself by `lowest_delta_r`, over the options evaluated in full in
+            // their own order (its ties go to the earlier position).
+            let mut scores = scores;
+            scores.sort_by_key(|s| s.0);
+            let only: Vec<Option<f64>> = scores.iter().map(|s| s.1).collect();
+            lowest_delta_r(&only).map_or((0, None), |best| scores[best])
         })
         .collect()
 }
