@@ -26,12 +26,12 @@ const SOLVED_TOL: f64 = 1e-13;
 /// Bound excess accepted from the local solve (relative).
 const BOUND_TOL: f64 = 1e-12;
 
-struct Layout {
+pub(crate) struct Layout {
     /// First unknown of each spring in `y`.
     start: Vec<usize>,
     /// First unknown of each counterweight (joint mode only): `m/M`, `μ/(M r_hi)`.
     cw_start: Vec<usize>,
-    unknowns: usize,
+    pub(crate) unknowns: usize,
 }
 
 /// `(M, R)`: the normalising mass and first-moment scales of a counterweight.
@@ -40,7 +40,9 @@ fn cw_scales(c: &crate::problem::CwSlot) -> (f64, f64) {
     (m, (m * c.bounds.radius[1]).max(1e-9 * m))
 }
 
-fn layout(problem: &VariantProblem, joint: bool) -> Layout {
+/// The unknowns of the local solve: per spring `ln K` and its anchor components, then (with
+/// `joint`) per counterweight its scaled mass and first moments.
+pub(crate) fn layout(problem: &VariantProblem, joint: bool) -> Layout {
     let mut start = Vec::new();
     let mut cw_start = Vec::new();
     let mut n = 0;
@@ -96,42 +98,49 @@ fn lifted_with(
     out
 }
 
-/// Residual rows and Jacobian of one point, built in place (the Levenberg–Marquardt loop
-/// evaluates thousands of points per variant, so the rows are written into reused buffers
-/// instead of being collected from per-row vectors).
+/// Residual rows and, when asked for, the Jacobian of one point, built in place (the
+/// Levenberg–Marquardt loop evaluates thousands of points per variant, so the rows are written
+/// into reused buffers instead of being collected from per-row vectors).
 struct Rows {
     unknowns: usize,
     /// Residual values.
     r: Vec<f64>,
-    /// Jacobian, row-major (`r.len() × unknowns`).
+    /// Whether the Jacobian is built.
+    jacobian: bool,
+    /// Jacobian, row-major (`r.len() × unknowns`); empty without `jacobian`.
     jac: Vec<f64>,
     /// Largest hinge value, and 0.
     hinge_max: f64,
 }
 
 impl Rows {
-    fn new(unknowns: usize) -> Rows {
+    fn new(unknowns: usize, jacobian: bool) -> Rows {
         Rows {
             unknowns,
             r: Vec::new(),
+            jacobian,
             jac: Vec::new(),
             hinge_max: 0.0,
         }
     }
 
-    /// Appends a row of zeros with residual `value` and returns its Jacobian row.
+    /// Appends a row with residual `value` and returns its Jacobian row, zeros (empty without
+    /// the Jacobian).
     fn push(&mut self, value: f64) -> &mut [f64] {
         self.r.push(value);
         let n = self.jac.len();
-        self.jac.resize(n + self.unknowns, 0.0);
+        if self.jacobian {
+            self.jac.resize(n + self.unknowns, 0.0);
+        }
         &mut self.jac[n..]
     }
 
     /// A bound hinge `max(value, 0)`, with gradient `grad` where it is active.
     fn hinge(&mut self, value: f64, grad: &[(usize, f64)]) {
         self.hinge_max = self.hinge_max.max(value);
+        let jacobian = self.jacobian;
         let row = self.push(value.max(0.0));
-        if value > 0.0 {
+        if value > 0.0 && jacobian {
             for &(j, g) in grad {
                 row[j] = g;
             }
@@ -142,29 +151,27 @@ impl Rows {
         DVector::from_column_slice(&self.r)
     }
 
-    fn matrix(&self) -> DMatrix<f64> {
-        DMatrix::from_row_slice(self.r.len(), self.unknowns, &self.jac)
+    /// The Jacobian, `None` when it was not built.
+    fn matrix(&self) -> Option<DMatrix<f64>> {
+        self.jacobian
+            .then(|| DMatrix::from_row_slice(self.r.len(), self.unknowns, &self.jac))
     }
 }
 
-/// Residual rows and Jacobian: balance (relative to ‖b‖), bound hinges, optional pull.
-fn residual(
+/// The balance rows' Jacobian (`rows × unknowns`, row-major, in `jac`) at `y`, whose lifted
+/// point is `xl`: per spring `∂/∂ ln K` (its own lifted vector) and `∂/∂a_i`, `∂/∂b_l`; per
+/// counterweight its scaled mass and first moments.
+fn balance_jacobian(
     problem: &VariantProblem,
-    b: &DVector<f64>,
-    x: &DVector<f64>,
     lay: &Layout,
     y: &DVector<f64>,
-    pull: Option<(&DVector<f64>, f64)>,
-) -> (DVector<f64>, DMatrix<f64>, f64, f64) {
+    xl: &DVector<f64>,
+    scale: f64,
+    jac: &mut [f64],
+) {
     let a = &problem.solution.matrix;
-    let scale = 1.0 / b.norm().max(f64::MIN_POSITIVE);
-    let xl = lifted_with(problem, x, lay, y);
     let rows = a.nrows();
-    let balance = (a * &xl + b) * scale;
     let n_unknowns = lay.unknowns;
-    let mut out = Rows::new(n_unknowns);
-    out.r.extend(balance.iter().copied());
-    out.jac.resize(rows * n_unknowns, 0.0);
     let mut d = vec![0.0; rows];
     for (k, s) in problem.springs.iter().enumerate() {
         let u = lay.start[k];
@@ -179,7 +186,7 @@ fn residual(
             for j in own.clone() {
                 dk += a[(row, j)] * xl[j];
             }
-            out.jac[row * n_unknowns + u] = dk * scale;
+            jac[row * n_unknowns + u] = dk * scale;
         }
         for i in 0..na {
             let c0 = a.column(s.column + 1 + i);
@@ -194,7 +201,7 @@ fn residual(
                 }
             }
             for row in 0..rows {
-                out.jac[row * n_unknowns + u + 1 + i] = d[row] * scale;
+                jac[row * n_unknowns + u + 1 + i] = d[row] * scale;
             }
         }
         for l in 0..nb {
@@ -210,9 +217,48 @@ fn residual(
                 }
             }
             for row in 0..rows {
-                out.jac[row * n_unknowns + u + 1 + na + l] = d[row] * scale;
+                jac[row * n_unknowns + u + 1 + na + l] = d[row] * scale;
             }
         }
+    }
+    for (c, &u) in problem.counterweights.iter().zip(&lay.cw_start) {
+        let (big_m, big_r) = cw_scales(c);
+        for row in 0..rows {
+            jac[row * n_unknowns + u] = a[(row, c.column)] * big_m * scale;
+            for k in 0..c.axes.len() {
+                jac[row * n_unknowns + u + 1 + k] = a[(row, c.column + 1 + k)] * big_r * scale;
+            }
+        }
+    }
+}
+
+/// Residual rows and, with `jacobian`, their Jacobian: balance (relative to ‖b‖), bound
+/// hinges, optional pull. The residuals are the same bits either way: the Levenberg–Marquardt
+/// loop asks for the Jacobian only at the points it moves to, not at the trial steps it rejects.
+pub(crate) fn residual(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    x: &DVector<f64>,
+    lay: &Layout,
+    y: &DVector<f64>,
+    pull: Option<(&DVector<f64>, f64)>,
+    jacobian: bool,
+) -> (DVector<f64>, Option<DMatrix<f64>>, f64, f64) {
+    let a = &problem.solution.matrix;
+    let scale = 1.0 / b.norm().max(f64::MIN_POSITIVE);
+    let xl = lifted_with(problem, x, lay, y);
+    let rows = a.nrows();
+    let balance = (a * &xl + b) * scale;
+    let n_unknowns = lay.unknowns;
+    let mut out = Rows::new(n_unknowns, jacobian);
+    out.r.extend(balance.iter().copied());
+    if jacobian {
+        out.jac.resize(rows * n_unknowns, 0.0);
+        balance_jacobian(problem, lay, y, &xl, scale, &mut out.jac);
+    }
+    for (k, s) in problem.springs.iter().enumerate() {
+        let u = lay.start[k];
+        let (na, nb) = (s.axes_a.len(), s.axes_b.len());
         // Bound hinges.
         let [klo, khi] = s.bounds.stiffness;
         if klo > 0.0 {
@@ -253,12 +299,6 @@ fn residual(
     }
     for (c, &u) in problem.counterweights.iter().zip(&lay.cw_start) {
         let (big_m, big_r) = cw_scales(c);
-        for row in 0..rows {
-            out.jac[row * n_unknowns + u] = a[(row, c.column)] * big_m * scale;
-            for k in 0..c.axes.len() {
-                out.jac[row * n_unknowns + u + 1 + k] = a[(row, c.column + 1 + k)] * big_r * scale;
-            }
-        }
         let n = c.axes.len();
         let mu = &y.as_slice()[u + 1..u + 1 + n];
         let len = norm(mu);
@@ -284,7 +324,10 @@ fn residual(
     if let Some((target, weight)) = pull {
         for j in 0..n_unknowns {
             let value = weight * (y[j] - target[j]);
-            out.push(value)[j] = weight;
+            let row = out.push(value);
+            if jacobian {
+                row[j] = weight;
+            }
         }
     }
     (out.vector(), out.matrix(), balance_norm, out.hinge_max)
@@ -298,7 +341,8 @@ fn levenberg_marquardt(
     mut y: DVector<f64>,
     pull: Option<(&DVector<f64>, f64)>,
 ) -> (DVector<f64>, f64, f64) {
-    let (mut r, mut jac, mut bal, mut hinge) = residual(problem, b, x, lay, &y, pull);
+    let (mut r, jac, mut bal, mut hinge) = residual(problem, b, x, lay, &y, pull, true);
+    let mut jac = jac.expect("asked for");
     let mut cost = r.norm();
     let mut lambda = 1e-3;
     let mut slow = 0;
@@ -330,13 +374,14 @@ fn levenberg_marquardt(
                 let u = lay.start[k];
                 cand[u] = cand[u].clamp(-30.0, 30.0);
             }
-            let (r2, j2, b2, h2) = residual(problem, b, x, lay, &cand, pull);
+            let (r2, _, b2, h2) = residual(problem, b, x, lay, &cand, pull, false);
             let c2 = r2.norm();
             if c2.is_finite() && c2 < cost {
                 let gain = (cost - c2) / cost.max(f64::MIN_POSITIVE);
+                let (_, j2, _, _) = residual(problem, b, x, lay, &cand, pull, true);
                 y = cand;
                 r = r2;
-                jac = j2;
+                jac = j2.expect("asked for");
                 bal = b2;
                 hinge = h2;
                 cost = c2;

@@ -1115,3 +1115,50 @@ fn the_spring_choice_without_hopeless_options_is_the_choice_over_all() {
     assert!(choices[choices.len() - 2].0 <= 1);
     assert!(choices[choices.len() - 1].0 <= 1);
 }
+
+/// The spring realization's residual on a hybrid and a springs-only palletizer variant, alone
+/// and with the Jacobian (the Levenberg–Marquardt loop builds the Jacobian only at the points
+/// it moves to): the same residual bits, and a Jacobian that agrees with central differences
+/// of the residual, column by column, at a generic point (hinges active and inactive).
+#[test]
+fn the_spring_residuals_jacobian_is_its_central_differences() {
+    use crate::springs::{layout, residual};
+    let json = case_json("palletizer.json");
+    let model = model(&json);
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let b = &ctx.basis.unbalanced;
+    for labels in [["m3", "K52"], ["K42", "K53"]] {
+        let run = run_after_loop(&ctx, &balanced_variant(&model, &labels), &options);
+        let problem = run.problem.as_ref().unwrap();
+        let x = &run.candidate.as_ref().unwrap().x;
+        for joint in [false, true] {
+            let lay = layout(problem, joint);
+            let y = DVector::from_fn(lay.unknowns, |j, _| {
+                0.35 * (j as f64 + 1.0).sin() + if j == 0 { 6.0 } else { 0.0 }
+            });
+            for pull in [None, Some((&y.map(|v| v + 0.01), 1e-3))] {
+                let (r, jac, bal, hinge) = residual(problem, b, x, &lay, &y, pull, true);
+                let (r0, none, bal0, hinge0) = residual(problem, b, x, &lay, &y, pull, false);
+                assert!(none.is_none());
+                assert_eq!((r.as_slice(), bal, hinge), (r0.as_slice(), bal0, hinge0));
+                let jac = jac.unwrap();
+                assert_eq!(jac.shape(), (r.len(), lay.unknowns));
+                let h = 1e-6;
+                for j in 0..lay.unknowns {
+                    let (mut up, mut down) = (y.clone(), y.clone());
+                    up[j] += h;
+                    down[j] -= h;
+                    let ru = residual(problem, b, x, &lay, &up, pull, false).0;
+                    let rd = residual(problem, b, x, &lay, &down, pull, false).0;
+                    let fd = (ru - rd) / (2.0 * h);
+                    let err = (&fd - jac.column(j)).amax();
+                    assert!(
+                        err <= 1e-6 * (1.0 + fd.amax()),
+                        "{labels:?} joint {joint} unknown {j}: {err:e}"
+                    );
+                }
+            }
+        }
+    }
+}
