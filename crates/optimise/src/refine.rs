@@ -480,5 +480,23 @@ mod tests {
             false,
         );
         assert!(all_runs > 3 * one_run, "{all_runs} against {one_run}");
+        // Without the stop, six runs from the minimum (none moves the centre), with simplices
+        // of 0.05, 0.01, 0.002, … : the evaluations of each, counted on `nelder_mead` alone.
+        let each: usize = (0..RESTARTS)
+            .map(|k| {
+                let mut count = 0;
+                nelder_mead(
+                    &mut |y, _| {
+                        count += 1;
+                        along(y)
+                    },
+                    &DVector::zeros(2),
+                    0.05 * 0.2f64.powi(k as i32),
+                    &mut 0,
+                );
+                count
+            })
+            .sum();
+        assert_eq!(all_runs, each);
     }
 }
