@@ -1116,7 +1116,8 @@ fn the_spring_choice_without_hopeless_options_is_the_choice_over_all() {
     assert!(choices[choices.len() - 1].0 <= 1);
 }
 
-/// The spring realization's residual on a hybrid and a springs-only palletizer variant, alone
+/// The spring realization's residual on two hybrid palletizer variants (m4 + K53's balance rows
+/// depend on its counterweight's first moments) and a springs-only one, alone
 /// and with the Jacobian (the Levenberg–Marquardt loop builds the Jacobian only at the points
 /// it moves to): the same residual bits, and a Jacobian that agrees with central differences
 /// of the residual, column by column, at a generic point (hinges active and inactive).
@@ -1128,7 +1129,7 @@ fn the_spring_residuals_jacobian_is_its_central_differences() {
     let ctx = Context::new(&model, None).unwrap();
     let options = OptimiseOptions::default();
     let b = &ctx.basis.unbalanced;
-    for labels in [["m3", "K52"], ["K42", "K53"]] {
+    for labels in [["m3", "K52"], ["K42", "K53"], ["m4", "K53"]] {
         let run = run_after_loop(&ctx, &balanced_variant(&model, &labels), &options);
         let problem = run.problem.as_ref().unwrap();
         let x = &run.candidate.as_ref().unwrap().x;
