@@ -71,6 +71,13 @@ fn lifted_with(
     y: &DVector<f64>,
 ) -> DVector<f64> {
     let mut out = x.clone();
+    lift_into(problem, lay, y, &mut out);
+    out
+}
+
+/// Writes `y`'s lifted values into the columns of `out` that `y` sets (the springs', and in
+/// joint mode the counterweights').
+fn lift_into(problem: &VariantProblem, lay: &Layout, y: &DVector<f64>, out: &mut DVector<f64>) {
     for (k, s) in problem.springs.iter().enumerate() {
         let u = lay.start[k];
         let (na, nb) = (s.axes_a.len(), s.axes_b.len());
@@ -94,67 +101,6 @@ fn lifted_with(
         for k in 0..c.axes.len() {
             out[c.column + 1 + k] = y[u + 1 + k] * big_r;
         }
-    }
-    out
-}
-
-/// Residual rows and, when asked for, the Jacobian of one point, built in place (the
-/// Levenberg–Marquardt loop evaluates thousands of points per variant, so the rows are written
-/// into reused buffers instead of being collected from per-row vectors).
-struct Rows {
-    unknowns: usize,
-    /// Residual values.
-    r: Vec<f64>,
-    /// Whether the Jacobian is built.
-    jacobian: bool,
-    /// Jacobian, row-major (`r.len() × unknowns`); empty without `jacobian`.
-    jac: Vec<f64>,
-    /// Largest hinge value, and 0.
-    hinge_max: f64,
-}
-
-impl Rows {
-    fn new(unknowns: usize, jacobian: bool) -> Rows {
-        Rows {
-            unknowns,
-            r: Vec::new(),
-            jacobian,
-            jac: Vec::new(),
-            hinge_max: 0.0,
-        }
-    }
-
-    /// Appends a row with residual `value` and returns its Jacobian row, zeros (empty without
-    /// the Jacobian).
-    fn push(&mut self, value: f64) -> &mut [f64] {
-        self.r.push(value);
-        let n = self.jac.len();
-        if self.jacobian {
-            self.jac.resize(n + self.unknowns, 0.0);
-        }
-        &mut self.jac[n..]
-    }
-
-    /// A bound hinge `max(value, 0)`, with gradient `grad` where it is active.
-    fn hinge(&mut self, value: f64, grad: &[(usize, f64)]) {
-        self.hinge_max = self.hinge_max.max(value);
-        let jacobian = self.jacobian;
-        let row = self.push(value.max(0.0));
-        if value > 0.0 && jacobian {
-            for &(j, g) in grad {
-                row[j] = g;
-            }
-        }
-    }
-
-    fn vector(&self) -> DVector<f64> {
-        DVector::from_column_slice(&self.r)
-    }
-
-    /// The Jacobian, `None` when it was not built.
-    fn matrix(&self) -> Option<DMatrix<f64>> {
-        self.jacobian
-            .then(|| DMatrix::from_row_slice(self.r.len(), self.unknowns, &self.jac))
     }
 }
 
@@ -232,34 +178,208 @@ fn balance_jacobian(
     }
 }
 
-/// Residual rows and, with `jacobian`, their Jacobian: balance (relative to ‖b‖), bound
-/// hinges, optional pull. The residuals are the same bits either way: the Levenberg–Marquardt
-/// loop asks for the Jacobian only at the points it moves to, not at the trial steps it rejects.
-pub(crate) fn residual(
-    problem: &VariantProblem,
-    b: &DVector<f64>,
-    x: &DVector<f64>,
-    lay: &Layout,
-    y: &DVector<f64>,
-    pull: Option<(&DVector<f64>, f64)>,
-    jacobian: bool,
-) -> (DVector<f64>, Option<DMatrix<f64>>, f64, f64) {
-    let a = &problem.solution.matrix;
-    let scale = 1.0 / b.norm().max(f64::MIN_POSITIVE);
-    let xl = lifted_with(problem, x, lay, y);
-    let rows = a.nrows();
-    let balance = (a * &xl + b) * scale;
-    let n_unknowns = lay.unknowns;
-    let mut out = Rows::new(n_unknowns, jacobian);
-    out.r.extend(balance.iter().copied());
-    if jacobian {
-        out.jac.resize(rows * n_unknowns, 0.0);
-        balance_jacobian(problem, lay, y, &xl, scale, &mut out.jac);
+/// The residual of one point of the local solve, in parts: the balance rows (relative to
+/// ‖b‖), the bound hinges `max(value, 0)` with the few gradient entries of each, and the pull
+/// rows `w (y − target)` (computed from `y` where needed). The Levenberg–Marquardt loop needs
+/// only the cost at a trial step and the normal equations at the points it moves to, so no
+/// dense Jacobian of the hinge and pull rows (mostly zeros) is ever built.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Residual {
+    /// Balance rows, scaled.
+    pub(crate) balance: Vec<f64>,
+    /// Per hinge: its value (negative when inactive) and the range of its gradient in `grads`.
+    hinges: Vec<(f64, usize, usize)>,
+    grads: Vec<(usize, f64)>,
+    /// ‖balance‖.
+    pub(crate) balance_norm: f64,
+    /// Largest hinge value, and 0.
+    pub(crate) hinge_max: f64,
+    /// ‖residual‖: balance, active hinges and pull.
+    pub(crate) cost: f64,
+}
+
+impl Residual {
+    fn clear(&mut self) {
+        self.balance.clear();
+        self.hinges.clear();
+        self.grads.clear();
+        self.hinge_max = 0.0;
     }
+
+    /// A bound hinge `max(value, 0)`, with gradient `grad` where it is active.
+    fn hinge(&mut self, value: f64, grad: &[(usize, f64)]) {
+        self.hinge_max = self.hinge_max.max(value);
+        let first = self.grads.len();
+        if value > 0.0 {
+            self.grads.extend_from_slice(grad);
+        }
+        self.hinges.push((value, first, self.grads.len()));
+    }
+
+    /// The residual rows as one vector: balance, every hinge (zero where inactive), pull.
+    #[cfg(test)]
+    pub(crate) fn rows(&self, y: &DVector<f64>, pull: Option<(&DVector<f64>, f64)>) -> Vec<f64> {
+        let mut out = self.balance.clone();
+        out.extend(self.hinges.iter().map(|h| h.0.max(0.0)));
+        if let Some((target, weight)) = pull {
+            out.extend((0..y.len()).map(|j| weight * (y[j] - target[j])));
+        }
+        out
+    }
+}
+
+/// The local solve of one variant's springs (and, in joint mode, counterweights): its residual
+/// at a point and the Gauss–Newton normal equations there.
+pub(crate) struct LocalSolve<'a> {
+    problem: &'a VariantProblem,
+    lay: &'a Layout,
+    pull: Option<(&'a DVector<f64>, f64)>,
+    /// 1/‖b‖.
+    scale: f64,
+    /// `A x + b` over the lifted columns that `y` does not set.
+    fixed: Vec<f64>,
+    /// The lifted columns that `y` sets, ascending.
+    varying: Vec<usize>,
+    /// The lifted point of the last `y` evaluated.
+    xl: DVector<f64>,
+    /// The balance rows' Jacobian, row-major (reused).
+    jac: Vec<f64>,
+}
+
+impl<'a> LocalSolve<'a> {
+    pub(crate) fn new(
+        problem: &'a VariantProblem,
+        b: &DVector<f64>,
+        x: &DVector<f64>,
+        lay: &'a Layout,
+        pull: Option<(&'a DVector<f64>, f64)>,
+    ) -> LocalSolve<'a> {
+        let a = &problem.solution.matrix;
+        let mut set = vec![false; x.len()];
+        for s in &problem.springs {
+            set[s.column..s.column + s.lifted_len()].fill(true);
+        }
+        if !lay.cw_start.is_empty() {
+            for c in &problem.counterweights {
+                set[c.column..c.column + 1 + c.axes.len()].fill(true);
+            }
+        }
+        let mut fixed = b.as_slice().to_vec();
+        for (j, &moves) in set.iter().enumerate() {
+            if !moves && x[j] != 0.0 {
+                for (f, &ajr) in fixed.iter_mut().zip(a.column(j).iter()) {
+                    *f += ajr * x[j];
+                }
+            }
+        }
+        LocalSolve {
+            problem,
+            lay,
+            pull,
+            scale: 1.0 / b.norm().max(f64::MIN_POSITIVE),
+            fixed,
+            varying: (0..x.len()).filter(|&j| set[j]).collect(),
+            xl: x.clone(),
+            jac: Vec::new(),
+        }
+    }
+
+    /// The residual at `y`, into `out` (its buffers reused).
+    pub(crate) fn evaluate(&mut self, y: &DVector<f64>, out: &mut Residual) {
+        lift_into(self.problem, self.lay, y, &mut self.xl);
+        let a = &self.problem.solution.matrix;
+        out.clear();
+        out.balance.extend_from_slice(&self.fixed);
+        for &j in &self.varying {
+            let v = self.xl[j];
+            for (r, &ajr) in out.balance.iter_mut().zip(a.column(j).iter()) {
+                *r += ajr * v;
+            }
+        }
+        for r in out.balance.iter_mut() {
+            *r *= self.scale;
+        }
+        bound_hinges(self.problem, self.lay, y, out);
+        let mut squares: f64 = out.balance.iter().map(|r| r * r).sum();
+        out.balance_norm = squares.sqrt();
+        squares += out.hinges.iter().map(|h| h.0.max(0.0).powi(2)).sum::<f64>();
+        if let Some((target, weight)) = self.pull {
+            squares += (0..y.len())
+                .map(|j| (weight * (y[j] - target[j])).powi(2))
+                .sum::<f64>();
+        }
+        out.cost = squares.sqrt();
+    }
+
+    /// The Gauss–Newton normal equations `(JᵀJ, Jᵀr)` at `y`, whose residual is `res`: the
+    /// balance block dense, each active hinge's outer product from its few entries, the pull's
+    /// diagonal.
+    pub(crate) fn normal_equations(
+        &mut self,
+        y: &DVector<f64>,
+        res: &Residual,
+    ) -> (DMatrix<f64>, DVector<f64>) {
+        let n = self.lay.unknowns;
+        let rows = res.balance.len();
+        lift_into(self.problem, self.lay, y, &mut self.xl);
+        self.jac.clear();
+        self.jac.resize(rows * n, 0.0);
+        balance_jacobian(
+            self.problem,
+            self.lay,
+            y,
+            &self.xl,
+            self.scale,
+            &mut self.jac,
+        );
+        let mut jtj = DMatrix::zeros(n, n);
+        let mut g = DVector::zeros(n);
+        for (row, &r) in self.jac.chunks_exact(n).zip(&res.balance) {
+            for i in 0..n {
+                let ji = row[i];
+                if ji == 0.0 {
+                    continue;
+                }
+                g[i] += ji * r;
+                for j in i..n {
+                    jtj[(i, j)] += ji * row[j];
+                }
+            }
+        }
+        for i in 0..n {
+            for j in 0..i {
+                jtj[(i, j)] = jtj[(j, i)];
+            }
+        }
+        for &(value, first, last) in &res.hinges {
+            if value <= 0.0 {
+                continue;
+            }
+            let grad = &res.grads[first..last];
+            for &(i, gi) in grad {
+                g[i] += gi * value;
+                for &(j, gj) in grad {
+                    jtj[(i, j)] += gi * gj;
+                }
+            }
+        }
+        if let Some((target, weight)) = self.pull {
+            for j in 0..n {
+                jtj[(j, j)] += weight * weight;
+                g[j] += weight * weight * (y[j] - target[j]);
+            }
+        }
+        (jtj, g)
+    }
+}
+
+/// The bound hinges at `y`: per spring `ln K` within its stiffness bounds, each anchor's length
+/// within its range and each anchor component within its box; per counterweight (joint mode)
+/// its scaled mass and radius within their bounds.
+fn bound_hinges(problem: &VariantProblem, lay: &Layout, y: &DVector<f64>, out: &mut Residual) {
     for (k, s) in problem.springs.iter().enumerate() {
         let u = lay.start[k];
         let (na, nb) = (s.axes_a.len(), s.axes_b.len());
-        // Bound hinges.
         let [klo, khi] = s.bounds.stiffness;
         if klo > 0.0 {
             out.hinge(klo.ln() - y[u], &[(u, -1.0)]);
@@ -320,17 +440,6 @@ pub(crate) fn residual(
         grad[n] = (u, lo);
         out.hinge(lo * y[u] - len, &grad[..n + 1]);
     }
-    let balance_norm = balance.norm();
-    if let Some((target, weight)) = pull {
-        for j in 0..n_unknowns {
-            let value = weight * (y[j] - target[j]);
-            let row = out.push(value);
-            if jacobian {
-                row[j] = weight;
-            }
-        }
-    }
-    (out.vector(), out.matrix(), balance_norm, out.hinge_max)
 }
 
 fn levenberg_marquardt(
@@ -341,9 +450,10 @@ fn levenberg_marquardt(
     mut y: DVector<f64>,
     pull: Option<(&DVector<f64>, f64)>,
 ) -> (DVector<f64>, f64, f64) {
-    let (mut r, jac, mut bal, mut hinge) = residual(problem, b, x, lay, &y, pull, true);
-    let mut jac = jac.expect("asked for");
-    let mut cost = r.norm();
+    let mut solve = LocalSolve::new(problem, b, x, lay, pull);
+    let mut res = Residual::default();
+    let mut trial = Residual::default();
+    solve.evaluate(&y, &mut res);
     let mut lambda = 1e-3;
     let mut slow = 0;
     for _ in 0..300 {
@@ -352,11 +462,10 @@ fn levenberg_marquardt(
         if slow >= 25 {
             break;
         }
-        if pull.is_none() && bal <= SOLVED_TOL && hinge <= BOUND_TOL {
+        if pull.is_none() && res.balance_norm <= SOLVED_TOL && res.hinge_max <= BOUND_TOL {
             break;
         }
-        let jtj = jac.transpose() * &jac;
-        let g = jac.transpose() * &r;
+        let (jtj, g) = solve.normal_equations(&y, &res);
         let mut improved = false;
         for _ in 0..12 {
             let mut damped = jtj.clone();
@@ -367,24 +476,18 @@ fn levenberg_marquardt(
                 lambda *= 10.0;
                 continue;
             };
-            let step = ch.solve(&(-&g));
-            let mut cand = &y + &step;
-            for (k, s) in problem.springs.iter().enumerate() {
-                let _ = s;
-                let u = lay.start[k];
+            let mut cand = -&g;
+            ch.solve_mut(&mut cand);
+            cand += &y;
+            for &u in &lay.start {
                 cand[u] = cand[u].clamp(-30.0, 30.0);
             }
-            let (r2, _, b2, h2) = residual(problem, b, x, lay, &cand, pull, false);
-            let c2 = r2.norm();
-            if c2.is_finite() && c2 < cost {
-                let gain = (cost - c2) / cost.max(f64::MIN_POSITIVE);
-                let (_, j2, _, _) = residual(problem, b, x, lay, &cand, pull, true);
+            solve.evaluate(&cand, &mut trial);
+            let c2 = trial.cost;
+            if c2.is_finite() && c2 < res.cost {
+                let gain = (res.cost - c2) / res.cost.max(f64::MIN_POSITIVE);
                 y = cand;
-                r = r2;
-                jac = j2.expect("asked for");
-                bal = b2;
-                hinge = h2;
-                cost = c2;
+                std::mem::swap(&mut res, &mut trial);
                 lambda = (lambda / 3.0).max(1e-15);
                 improved = gain > 1e-15;
                 slow = if gain < 1e-3 { slow + 1 } else { 0 };
@@ -396,7 +499,7 @@ fn levenberg_marquardt(
             break;
         }
     }
-    (y, bal, hinge)
+    (y, res.balance_norm, res.hinge_max)
 }
 
 /// Physical springs at `y`.

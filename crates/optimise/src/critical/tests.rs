@@ -1116,19 +1116,21 @@ fn the_spring_choice_without_hopeless_options_is_the_choice_over_all() {
     assert!(choices[choices.len() - 1].0 <= 1);
 }
 
-/// The spring realization's residual on two hybrid palletizer variants (m4 + K53's balance rows
-/// depend on its counterweight's first moments) and a springs-only one, alone
-/// and with the Jacobian (the Levenberg–Marquardt loop builds the Jacobian only at the points
-/// it moves to): the same residual bits, and a Jacobian that agrees with central differences
-/// of the residual, column by column, at a generic point (hinges active and inactive).
+/// The spring realization's normal equations on two hybrid palletizer variants (m4 + K53's
+/// balance rows depend on its counterweight's first moments) and a springs-only one, springs
+/// alone and joint with the counterweights, with and without the pull rows: `JᵀJ` and `Jᵀr`,
+/// assembled from the balance block and each active hinge's few entries, agree with those of
+/// the Jacobian taken by central differences of the whole residual vector at a generic point
+/// (hinges active and inactive), and the residual's norms are its rows'.
 #[test]
-fn the_spring_residuals_jacobian_is_its_central_differences() {
-    use crate::springs::{layout, residual};
+fn the_spring_normal_equations_are_those_of_the_central_difference_jacobian() {
+    use crate::springs::{LocalSolve, Residual, layout};
     let json = case_json("palletizer.json");
     let model = model(&json);
     let ctx = Context::new(&model, None).unwrap();
     let options = OptimiseOptions::default();
     let b = &ctx.basis.unbalanced;
+    let mut active_hinges = 0;
     for labels in [["m3", "K52"], ["K42", "K53"], ["m4", "K53"]] {
         let run = run_after_loop(&ctx, &balanced_variant(&model, &labels), &options);
         let problem = run.problem.as_ref().unwrap();
@@ -1138,28 +1140,44 @@ fn the_spring_residuals_jacobian_is_its_central_differences() {
             let y = DVector::from_fn(lay.unknowns, |j, _| {
                 0.35 * (j as f64 + 1.0).sin() + if j == 0 { 6.0 } else { 0.0 }
             });
-            for pull in [None, Some((&y.map(|v| v + 0.01), 1e-3))] {
-                let (r, jac, bal, hinge) = residual(problem, b, x, &lay, &y, pull, true);
-                let (r0, none, bal0, hinge0) = residual(problem, b, x, &lay, &y, pull, false);
-                assert!(none.is_none());
-                assert_eq!((r.as_slice(), bal, hinge), (r0.as_slice(), bal0, hinge0));
-                let jac = jac.unwrap();
-                assert_eq!(jac.shape(), (r.len(), lay.unknowns));
+            let target = y.map(|v| v + 0.01);
+            for pull in [None, Some((&target, 1e-3))] {
+                let mut solve = LocalSolve::new(problem, b, x, &lay, pull);
+                let rows_at = |solve: &mut LocalSolve, y: &DVector<f64>| {
+                    let mut res = Residual::default();
+                    solve.evaluate(y, &mut res);
+                    DVector::from_vec(res.rows(y, pull))
+                };
+                let mut res = Residual::default();
+                solve.evaluate(&y, &mut res);
+                let r = DVector::from_vec(res.rows(&y, pull));
+                let balance = DVector::from_column_slice(&res.balance);
+                assert!((res.cost - r.norm()).abs() <= 1e-14 * r.norm());
+                assert!((res.balance_norm - balance.norm()).abs() <= 1e-14 * balance.norm());
+                active_hinges += r.iter().skip(balance.len()).filter(|&&v| v > 0.0).count();
                 let h = 1e-6;
+                let mut jac = nalgebra::DMatrix::zeros(r.len(), lay.unknowns);
                 for j in 0..lay.unknowns {
                     let (mut up, mut down) = (y.clone(), y.clone());
                     up[j] += h;
                     down[j] -= h;
-                    let ru = residual(problem, b, x, &lay, &up, pull, false).0;
-                    let rd = residual(problem, b, x, &lay, &down, pull, false).0;
-                    let fd = (ru - rd) / (2.0 * h);
-                    let err = (&fd - jac.column(j)).amax();
-                    assert!(
-                        err <= 1e-6 * (1.0 + fd.amax()),
-                        "{labels:?} joint {joint} unknown {j}: {err:e}"
-                    );
+                    let fd = (rows_at(&mut solve, &up) - rows_at(&mut solve, &down)) / (2.0 * h);
+                    jac.set_column(j, &fd);
                 }
+                let (jtj, g) = solve.normal_equations(&y, &res);
+                let (jtj_fd, g_fd) = (jac.transpose() * &jac, jac.transpose() * &r);
+                let err = (&jtj - &jtj_fd).amax();
+                assert!(
+                    err <= 1e-6 * (1.0 + jtj_fd.amax()),
+                    "{labels:?} joint {joint}: JᵀJ off by {err:e}"
+                );
+                let err = (&g - &g_fd).amax();
+                assert!(
+                    err <= 1e-6 * (1.0 + g_fd.amax()),
+                    "{labels:?} joint {joint}: Jᵀr off by {err:e}"
+                );
             }
         }
     }
+    assert!(active_hinges > 0, "the point leaves every bound inactive");
 }
