@@ -140,7 +140,12 @@ impl Affine {
 pub struct ConicProblem {
     pub variables: usize,
     pub objective: Vec<f64>,
-    rows: Vec<Row>,
+    /// The constraint rows, flat: row `i`'s `(variable, coefficient)` terms are
+    /// `terms[row_start[i]..row_start[i + 1]]`, variables ascending. One allocation for all
+    /// rows, so that the branch-and-bound's copy of a base problem per box is three copies of
+    /// memory rather than one tree per row.
+    row_start: Vec<usize>,
+    terms: Vec<(usize, f64)>,
     rhs: Vec<f64>,
     cones: Vec<Cone>,
     /// Optimality and feasibility tolerance of the first runs, when not clarabel's 1e-8 (see
@@ -179,8 +184,11 @@ impl ConicProblem {
     /// Cone slack `s = b − A x` from the affine expression `e(x) = c + d·x`: `s = e(x)` means
     /// row `−d`, rhs `c`.
     fn push_expr(&mut self, e: &Affine) {
-        let row: Row = e.terms.iter().map(|(&j, &c)| (j, -c)).collect();
-        self.rows.push(row);
+        if self.row_start.is_empty() {
+            self.row_start.push(0);
+        }
+        self.terms.extend(e.terms.iter().map(|(&j, &c)| (j, -c)));
+        self.row_start.push(self.terms.len());
         self.rhs.push(e.constant);
     }
 
@@ -239,7 +247,7 @@ impl ConicProblem {
     }
 
     pub fn rows(&self) -> usize {
-        self.rows.len()
+        self.rhs.len()
     }
 
     /// Solves with clarabel (quiet, deterministic); when clarabel stops short of `Solved`
@@ -267,26 +275,29 @@ impl ConicProblem {
 
     fn solve_attempt(&self, max_iter: u32, attempt: u32) -> ConicSolution {
         let n = self.variables;
-        let m = self.rows.len();
-        // Column-major CSC from the rows.
-        let mut columns: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
-        for (i, row) in self.rows.iter().enumerate() {
-            for (&j, &c) in row {
-                if c != 0.0 {
-                    columns[j].push((i, c));
-                }
-            }
+        let m = self.rhs.len();
+        // Column-major CSC from the rows (within a column, rows ascending; zeros left out).
+        let rows = || {
+            self.row_start
+                .windows(2)
+                .enumerate()
+                .flat_map(|(i, w)| self.terms[w[0]..w[1]].iter().map(move |&(j, c)| (i, j, c)))
+                .filter(|&(_, _, c)| c != 0.0)
+        };
+        let mut colptr = vec![0usize; n + 1];
+        for (_, j, _) in rows() {
+            colptr[j + 1] += 1;
         }
-        let mut colptr = Vec::with_capacity(n + 1);
-        let mut rowval = Vec::new();
-        let mut nzval = Vec::new();
-        colptr.push(0);
-        for col in &columns {
-            for &(i, c) in col {
-                rowval.push(i);
-                nzval.push(c);
-            }
-            colptr.push(rowval.len());
+        for j in 0..n {
+            colptr[j + 1] += colptr[j];
+        }
+        let nnz = colptr[n];
+        let mut next = colptr.clone();
+        let (mut rowval, mut nzval) = (vec![0usize; nnz], vec![0.0; nnz]);
+        for (i, j, c) in rows() {
+            rowval[next[j]] = i;
+            nzval[next[j]] = c;
+            next[j] += 1;
         }
         let a = CscMatrix::new(m, n, colptr, rowval, nzval);
         let p = CscMatrix::zeros((n, n));

@@ -295,7 +295,8 @@ pub fn solve_relaxation_in(
 #[derive(Clone)]
 struct Built {
     cp: ConicProblem,
-    peaks: Vec<Affine>,
+    /// The peak rows a solve may add (shared: every box's copy of the base reads the same).
+    peaks: Arc<[Affine]>,
     z: Vec<usize>,
     dz: Vec<f64>,
     tau_scale: f64,
@@ -1073,7 +1074,7 @@ fn build(
     }
     Built {
         cp,
-        peaks,
+        peaks: peaks.into(),
         z,
         dz,
         tau_scale,
