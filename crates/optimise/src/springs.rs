@@ -194,7 +194,8 @@ fn balance_jacobian(
 pub(crate) struct Residual {
     /// Balance rows, scaled.
     pub(crate) balance: Vec<f64>,
-    /// Per hinge: its value (negative when inactive) and the range of its gradient in `grads`.
+    /// Per hinge: its value (≤ 0 when inactive) and the range of its gradient in `grads` (empty
+    /// when inactive).
     hinges: Vec<(f64, usize, usize)>,
     grads: Vec<(usize, f64)>,
     /// ‖balance‖.
