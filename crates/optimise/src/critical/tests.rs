@@ -1165,6 +1165,26 @@ fn the_spring_normal_equations_are_those_of_the_central_difference_jacobian() {
                     jac.set_column(j, &fd);
                 }
                 let (jtj, g) = solve.normal_equations(&y, &res);
+                if let Some((target, weight)) = pull {
+                    // The pull's rows add `w²` to the diagonal and `w² (y − target)` to `Jᵀr`
+                    // (a millionth of the balance block: checked apart from it).
+                    let mut unpulled = LocalSolve::new(problem, b, x, &lay, None);
+                    let mut res0 = Residual::default();
+                    unpulled.evaluate(&y, &mut res0);
+                    let (jtj0, g0) = unpulled.normal_equations(&y, &res0);
+                    let w2 = weight * weight;
+                    for i in 0..lay.unknowns {
+                        let want = w2 * (y[i] - target[i]);
+                        let tol = 1e-12 * (1.0 + g0[i].abs());
+                        assert!((g[i] - g0[i] - want).abs() <= tol, "pull in Jᵀr, {i}");
+                        for j in 0..lay.unknowns {
+                            let want = if i == j { w2 } else { 0.0 };
+                            let tol = 1e-12 * (1.0 + jtj0[(i, j)].abs());
+                            let d = jtj[(i, j)] - jtj0[(i, j)];
+                            assert!((d - want).abs() <= tol, "pull in JᵀJ, ({i}, {j})");
+                        }
+                    }
+                }
                 let (jtj_fd, g_fd) = (jac.transpose() * &jac, jac.transpose() * &r);
                 let err = (&jtj - &jtj_fd).amax();
                 assert!(
