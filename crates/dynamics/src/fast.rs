@@ -83,6 +83,8 @@ struct Work {
     /// `[Δ = 0 | unused | change to +1 | change to −1]`, `cols` each (the layout of `out` with
     /// every column its own group).
     sum_out: Vec<f64>,
+    /// With [`Superposition`]: the buffers of its sums.
+    sums: SumScratch,
     /// Coefficients of the current sub-task, per sample (`stride` values): the motor torques
     /// as quadratics in `Δ` — three arrays `[actuator][column]` — then, with reactions,
     /// `|F_j|²` and `|M_j|²` as quartics — five arrays `[force/moment][joint][column]`.
@@ -727,9 +729,9 @@ fn sub_task(
         // The stored columns' values: the evaluated ones, or their sums over the basis.
         let (torques, out, solved, nreps, group, cols) = match superposition {
             Some(sup) => {
-                sup.torques(&work.torques, n, &mut work.sum_torques);
+                sup.torques(&work.torques, n, &mut work.sum_torques, &mut work.sums);
                 if with_reactions {
-                    sup.reactions(&work.out, solved, 6 * nj, &mut work.sum_out);
+                    sup.reactions(&work.out, solved, 6 * nj, &mut work.sum_out, &mut work.sums);
                 }
                 let c = out_cols;
                 let group = &sup.identity[..];

@@ -81,10 +81,11 @@ pub(crate) struct Superposition {
     /// `p₀` and the unit columns, in row order.
     pub(crate) basis: ParameterSet,
     pub(crate) groups: InertiaGroups,
-    /// Per basis column: whether it changes with `Δ` (`p₀` and the body rows).
-    pub(crate) inertial: Vec<bool>,
     /// Per column: `(basis column, p_r − p₀_r)` over the rows where it differs, ascending.
     pub(crate) terms: Vec<Vec<(u32, f64)>>,
+    /// Per column: `(group, p_r − p₀_r)` over its inertial terms (the ones that change with
+    /// `Δ`), in the terms' order.
+    change_terms: Vec<Vec<(u32, f64)>>,
     /// Every column its own group.
     pub(crate) identity: Vec<u32>,
 }
@@ -114,7 +115,7 @@ impl Superposition {
             index[r] = (basis.len() - 1) as u32;
             inertial.push(r < inertial_rows);
         }
-        let terms = (0..params.len())
+        let terms: Vec<Vec<(u32, f64)>> = (0..params.len())
             .map(|p| {
                 used.iter()
                     .filter(|&&r| differs(p, r))
@@ -122,92 +123,322 @@ impl Superposition {
                     .collect()
             })
             .collect();
+        let groups = InertiaGroups::new(&basis);
+        let change_terms = terms
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .filter(|&&(k, _)| inertial[k as usize])
+                    .map(|&(k, c)| (groups.group[k as usize], c))
+                    .collect()
+            })
+            .collect();
         Superposition {
-            groups: InertiaGroups::new(&basis),
+            groups,
             basis,
-            inertial,
             terms,
+            change_terms,
             identity: (0..params.len() as u32).collect(),
         }
     }
 
-    /// Every column's torques `[Δ][actuator][column]` from the basis's `[Δ][actuator][basis]`.
-    pub(crate) fn torques(&self, basis: &[f64], n: usize, dst: &mut Vec<f64>) {
-        let (nb, cols) = (self.basis.len(), self.terms.len());
-        dst.resize(3 * n * cols, 0.0);
-        for da in 0..3 * n {
-            let src = &basis[da * nb..(da + 1) * nb];
-            sum_terms(&self.terms, src, &mut dst[da * cols..(da + 1) * cols]);
-        }
+    /// Every column's torques `[Δ][actuator][column]` from the basis's `[Δ][actuator][basis]`
+    /// (`scratch` holds the transposed basis and the columns' sums between calls).
+    pub(crate) fn torques(
+        &self,
+        basis: &[f64],
+        n: usize,
+        dst: &mut Vec<f64>,
+        scratch: &mut SumScratch,
+    ) {
+        let (nb, cols, len) = (self.basis.len(), self.terms.len(), 3 * n);
+        let width = len.next_multiple_of(8);
+        dst.resize(len * cols, 0.0);
+        transpose_into(&mut scratch.basis, basis, len, width, nb, nb, 0);
+        scratch.sums.resize(cols * width, 0.0);
+        sum_vectors(&self.terms, 0, &scratch.basis, width, &mut scratch.sums);
+        transpose_from(dst, &scratch.sums, len, width, cols, cols, 0);
     }
 
     /// Every column's reaction components (the layout of `Work::sum_out`) from the basis's
     /// (`out`, `solved` values per component row: the basis columns at `Δ = 0`, the groups at
     /// `Δ = 0` (unused), their changes to `+1`, to `−1`).
+    ///
+    /// The basis's values are transposed to one contiguous vector per basis column (or group),
+    /// so that each term of a column's sum is one vectorised multiply-add over all the
+    /// component rows; each value is still the fold of its own terms in their order, the same
+    /// bits as a scalar sum per row (`the_vector_sums_are_the_scalar_folds`).
     pub(crate) fn reactions(
         &self,
         out: &[f64],
         solved: usize,
         component_rows: usize,
         dst: &mut Vec<f64>,
+        scratch: &mut SumScratch,
     ) {
         let (nb, nreps, cols) = (
             self.basis.len(),
             self.groups.rep_batch.len(),
             self.terms.len(),
         );
-        let group = &self.groups.group;
-        dst.resize(component_rows * 4 * cols, 0.0);
-        for row in 0..component_rows {
-            let src = &out[row * solved..(row + 1) * solved];
-            let (at_zero, rest) = src.split_at(nb);
-            let changes = &rest[nreps..];
-            let (plus, minus) = changes.split_at(nreps);
-            let dst = &mut dst[row * 4 * cols..(row + 1) * 4 * cols];
-            let (d0, rest) = dst.split_at_mut(2 * cols);
-            let (dp, dm) = rest.split_at_mut(cols);
-            sum_terms(&self.terms, at_zero, &mut d0[..cols]);
-            sum_changes(&self.terms, &self.inertial, group, [plus, minus], [dp, dm]);
+        let len = component_rows;
+        let width = len.next_multiple_of(8);
+        dst.resize(len * 4 * cols, 0.0);
+        scratch.sums.resize(cols * width, 0.0);
+        // Δ = 0: the basis columns.
+        transpose_into(&mut scratch.basis, out, len, width, nb, solved, 0);
+        sum_vectors(&self.terms, 0, &scratch.basis, width, &mut scratch.sums);
+        transpose_from(dst, &scratch.sums, len, width, cols, 4 * cols, 0);
+        // The changes to Δ = +1 and −1: the groups' of the inertial terms.
+        let first = self.groups.group[0] as usize;
+        for (side, offset) in [(0, 2 * cols), (1, 3 * cols)] {
+            let from = nb + (1 + side) * nreps;
+            transpose_into(&mut scratch.basis, out, len, width, nreps, solved, from);
+            sum_vectors(
+                &self.change_terms,
+                first,
+                &scratch.basis,
+                width,
+                &mut scratch.sums,
+            );
+            transpose_from(dst, &scratch.sums, len, width, cols, 4 * cols, offset);
         }
     }
 }
 
-crate::simd::multiversion! {
-/// `dst[p] = src[0] + Σ c·src[k]` over column `p`'s terms `(k, c)`, fused multiply-adds in the
-/// terms' order (multiversioned: without the FMA instruction `mul_add` is a library call).
-pub(crate) fn sum_terms(terms: &[Vec<(u32, f64)>], src: &[f64], dst: &mut [f64]) {
-    for (d, terms) in dst.iter_mut().zip(terms) {
-        *d = terms
-            .iter()
-            .fold(src[0], |acc, &(k, c)| c.mul_add(src[k as usize], acc));
-    }
-}
+/// Buffers of [`Superposition`]'s sums, reused from sample to sample.
+#[derive(Default)]
+pub(crate) struct SumScratch {
+    /// The basis's values, one contiguous vector per basis column or group.
+    basis: Vec<f64>,
+    /// Every column's sums, one contiguous vector per column.
+    sums: Vec<f64>,
 }
 
-crate::simd::multiversion! {
-/// Every column's changes to `Δ = ±1`: the base column's group's plus `c` times each inertial
-/// term's group's (spring rows do not change with `Δ`), in the terms' order.
-pub(crate) fn sum_changes(
-    terms: &[Vec<(u32, f64)>],
-    inertial: &[bool],
-    group: &[u32],
-    changes: [&[f64]; 2],
-    dst: [&mut [f64]; 2],
+/// Columns per tile of the transposes: a tile's vectors stay in the first-level cache while
+/// its rows are copied.
+const TILE: usize = 32;
+
+/// `dst[k·width + r] = src[r·stride + offset + k]` for `k < count`, `r < len` (the rows from
+/// `len` to `width` zero).
+fn transpose_into(
+    dst: &mut Vec<f64>,
+    src: &[f64],
+    len: usize,
+    width: usize,
+    count: usize,
+    stride: usize,
+    offset: usize,
 ) {
-    let [plus, minus] = changes;
-    let [dp, dm] = dst;
-    let g0 = group[0] as usize;
-    for (p, terms) in terms.iter().enumerate() {
-        let (mut sp, mut sm) = (plus[g0], minus[g0]);
-        for &(k, c) in terms {
-            if inertial[k as usize] {
-                let g = group[k as usize] as usize;
-                sp = c.mul_add(plus[g], sp);
-                sm = c.mul_add(minus[g], sm);
+    dst.resize(count * width, 0.0);
+    for k0 in (0..count).step_by(TILE) {
+        let k1 = (k0 + TILE).min(count);
+        for r in 0..len {
+            let row = &src[r * stride + offset + k0..][..k1 - k0];
+            for (k, &x) in (k0..k1).zip(row) {
+                dst[k * width + r] = x;
             }
         }
-        dp[p] = sp;
-        dm[p] = sm;
+    }
+    for vector in dst.chunks_exact_mut(width) {
+        vector[len..].fill(0.0);
     }
 }
+
+/// `dst[r·stride + offset + p] = src[p·width + r]` for `p < count`, `r < len`.
+fn transpose_from(
+    dst: &mut [f64],
+    src: &[f64],
+    len: usize,
+    width: usize,
+    count: usize,
+    stride: usize,
+    offset: usize,
+) {
+    for p0 in (0..count).step_by(TILE) {
+        let p1 = (p0 + TILE).min(count);
+        for r in 0..len {
+            let row = &mut dst[r * stride + offset + p0..][..p1 - p0];
+            for (p, d) in (p0..p1).zip(row) {
+                *d = src[p * width + r];
+            }
+        }
+    }
+}
+
+crate::simd::multiversion! {
+/// Every column's sum, `dst[p] = src[first] + Σ c·src[k]` over column `p`'s terms `(k, c)` in
+/// their order, as vectors of `width` values (`src` one vector per basis column or group,
+/// `dst` one per column; `width` a multiple of 8). The rows are taken in blocks held in
+/// registers across the terms: fused multiply-adds (multiversioned: without the FMA
+/// instruction `mul_add` is a library call), each value the fold of its terms in order.
+fn sum_vectors(terms: &[Vec<(u32, f64)>], first: usize, src: &[f64], width: usize, dst: &mut [f64]) {
+    for (acc, terms) in dst.chunks_exact_mut(width).zip(terms) {
+        // A vector of up to 72 rows is held whole (nine 512-bit registers: enough independent
+        // multiply-adds per term to hide their latency); a longer one in blocks.
+        match width {
+            8 => sum_block::<8>(terms, src, width, first, 0, acc),
+            16 => sum_block::<16>(terms, src, width, first, 0, acc),
+            24 => sum_block::<24>(terms, src, width, first, 0, acc),
+            32 => sum_block::<32>(terms, src, width, first, 0, acc),
+            40 => sum_block::<40>(terms, src, width, first, 0, acc),
+            48 => sum_block::<48>(terms, src, width, first, 0, acc),
+            56 => sum_block::<56>(terms, src, width, first, 0, acc),
+            64 => sum_block::<64>(terms, src, width, first, 0, acc),
+            72 => sum_block::<72>(terms, src, width, first, 0, acc),
+            _ => {
+                let mut r = 0;
+                while r + SUM_BLOCK <= width {
+                    sum_block::<SUM_BLOCK>(terms, src, width, first, r, acc);
+                    r += SUM_BLOCK;
+                }
+                while r < width {
+                    sum_block::<8>(terms, src, width, first, r, acc);
+                    r += 8;
+                }
+            }
+        }
+    }
+}
+}
+
+/// Rows per register block of [`sum_vectors`] for vectors longer than 72 rows.
+const SUM_BLOCK: usize = 32;
+
+/// `acc[r..r + W] = src[first][r..r + W] + Σ c·src[k][r..r + W]` over `terms`, in order
+/// (vectors `width` apart in `src`).
+#[inline(always)]
+fn sum_block<const W: usize>(
+    terms: &[(u32, f64)],
+    src: &[f64],
+    width: usize,
+    first: usize,
+    r: usize,
+    acc: &mut [f64],
+) {
+    let block = |k: usize| -> &[f64; W] {
+        let start = k * width + r;
+        src[start..start + W]
+            .try_into()
+            .expect("a block of W values")
+    };
+    let mut a = *block(first);
+    for &(k, c) in terms {
+        let x = block(k as usize);
+        for i in 0..W {
+            a[i] = c.mul_add(x[i], a[i]);
+        }
+    }
+    acc[r..r + W].copy_from_slice(&a);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scalar sums the vector ones replace: per value, the fold of its column's terms (the
+    /// changes with `Δ` over the inertial ones: unit columns of a body row).
+    fn scalar_sums(sup: &Superposition, out: &[f64], solved: usize, len: usize) -> Vec<f64> {
+        let (nb, nreps, cols) = (sup.basis.len(), sup.groups.rep_batch.len(), sup.terms.len());
+        let group = &sup.groups.group;
+        let inertial_rows = crate::params::BODY_PARAMS * sup.basis.bodies;
+        let inertial: Vec<bool> = (0..nb)
+            .map(|k| k == 0 || sup.basis.column(k)[..inertial_rows].contains(&1.0))
+            .collect();
+        let mut dst = vec![0.0; len * 4 * cols];
+        for r in 0..len {
+            let row = &out[r * solved..(r + 1) * solved];
+            for (p, terms) in sup.terms.iter().enumerate() {
+                let zero = terms
+                    .iter()
+                    .fold(row[0], |acc, &(k, c)| c.mul_add(row[k as usize], acc));
+                dst[r * 4 * cols + p] = zero;
+                for side in 0..2 {
+                    let change = |g: u32| row[nb + (1 + side) * nreps + g as usize];
+                    let sum = terms
+                        .iter()
+                        .filter(|&&(k, _)| inertial[k as usize])
+                        .fold(change(group[0]), |acc, &(k, c)| {
+                            c.mul_add(change(group[k as usize]), acc)
+                        });
+                    dst[r * 4 * cols + (2 + side) * cols + p] = sum;
+                }
+            }
+        }
+        dst
+    }
+
+    #[test]
+    fn the_vector_sums_are_the_scalar_folds() {
+        // Two bodies, a spring slot; columns differing from the base in body rows (inertial)
+        // and spring rows, some in several rows, one not at all.
+        let bodies = 2;
+        let slot = crate::params::SpringSlot {
+            body: 0,
+            other: None,
+        };
+        let mut params = ParameterSet::empty(bodies, vec![slot]);
+        let rows = params.rows();
+        let base: Vec<f64> = (0..crate::params::BODY_PARAMS * bodies)
+            .map(|r| 1.0 + r as f64 / 7.0)
+            .collect();
+        let mut full = base.clone();
+        full.resize(rows, 0.0);
+        let mut x = 0.3f64;
+        let mut next = || {
+            x = (x * 3.7 + 0.11).fract();
+            x - 0.5
+        };
+        for changed in [
+            vec![],
+            vec![0],
+            vec![3, 12],
+            vec![rows - 1],
+            vec![1, 5, rows - 2],
+        ] {
+            let mut column = full.clone();
+            for r in changed {
+                column[r] += next();
+            }
+            params.push_column(&column).unwrap();
+        }
+        let sup = Superposition::new(&base, &params);
+        let nb = sup.basis.len();
+        let nreps = sup.groups.rep_batch.len();
+        assert!(nreps >= 3, "inertial unit columns are groups of their own");
+        let len = 11;
+        let solved = nb + 3 * nreps + 2;
+        let out: Vec<f64> = (0..len * solved).map(|_| next() * 1e3).collect();
+        let mut dst = Vec::new();
+        sup.reactions(&out, solved, len, &mut dst, &mut SumScratch::default());
+        let expected = scalar_sums(&sup, &out, solved, len);
+        let cols = sup.terms.len();
+        for r in 0..len {
+            for part in [0, 2, 3] {
+                for p in 0..cols {
+                    let i = r * 4 * cols + part * cols + p;
+                    assert_eq!(
+                        dst[i].to_bits(),
+                        expected[i].to_bits(),
+                        "row {r} part {part} column {p}"
+                    );
+                }
+            }
+        }
+        // A column with no terms is the base column; the torques are the same sums at Δ = 0.
+        assert_eq!(dst[0].to_bits(), out[0].to_bits());
+        let n = 2;
+        let torques: Vec<f64> = (0..3 * n * nb).map(|_| next()).collect();
+        let mut summed = Vec::new();
+        sup.torques(&torques, n, &mut summed, &mut SumScratch::default());
+        for da in 0..3 * n {
+            let src = &torques[da * nb..(da + 1) * nb];
+            for (p, terms) in sup.terms.iter().enumerate() {
+                let fold = terms
+                    .iter()
+                    .fold(src[0], |acc, &(k, c)| c.mul_add(src[k as usize], acc));
+                assert_eq!(summed[da * cols + p].to_bits(), fold.to_bits());
+            }
+        }
+    }
 }
