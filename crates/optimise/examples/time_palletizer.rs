@@ -18,7 +18,9 @@ use counterpoise_balance::{
 };
 use counterpoise_dynamics::{EvaluateOptions, evaluate_unbalanced_grid};
 use counterpoise_model::Case;
-use counterpoise_optimise::{Context, FinalReactionSolve, OptimiseOptions, optimise_all};
+use counterpoise_optimise::{
+    Context, FinalReactionSolve, LoopTorques, OptimiseOptions, optimise_all,
+};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -72,6 +74,7 @@ fn main() {
         // the final evaluation's reaction solve as a study chooses it
         let options = OptimiseOptions {
             final_reaction_solve: FinalReactionSolve::for_study(&model, balanced.len()),
+            loop_torques: LoopTorques::for_study(&model, balanced.len()),
             ..OptimiseOptions::default()
         };
         last = optimise_all(&ctx, &balanced, &options);

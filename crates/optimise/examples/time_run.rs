@@ -17,7 +17,8 @@ use counterpoise_balance::{
 use counterpoise_dynamics::{EvaluateOptions, evaluate_unbalanced_grid};
 use counterpoise_model::Case;
 use counterpoise_optimise::{
-    Context, FinalReactionSolve, OptimiseOptions, StageTime, Stopwatch, optimise_all_timed,
+    Context, FinalReactionSolve, LoopTorques, OptimiseOptions, StageTime, Stopwatch,
+    optimise_all_timed,
 };
 
 fn median_range(mut v: Vec<f64>) -> String {
@@ -82,6 +83,7 @@ fn main() {
             .count();
         let options = OptimiseOptions {
             final_reaction_solve: FinalReactionSolve::for_study(&model, balanced),
+            loop_torques: LoopTorques::for_study(&model, balanced),
             ..OptimiseOptions::default()
         };
         let (out, stages) = optimise_all_timed(&ctx, &report.variants, &options);

@@ -43,8 +43,8 @@ pub mod verify;
 pub use clarabel_map::ConicStatus;
 pub use context::Context;
 pub use critical::{
-    FinalReactionSolve, OptimiseOptions, StageTimings, delta_r, lowest_delta_r, objective_of,
-    optimise_all, optimise_all_reporting, optimise_all_timed, optimise_variant,
+    FinalReactionSolve, LoopTorques, OptimiseOptions, StageTimings, delta_r, lowest_delta_r,
+    objective_of, optimise_all, optimise_all_reporting, optimise_all_timed, optimise_variant,
 };
 pub use error::OptimiseError;
 pub use overrides::{BoundsTable, CounterweightBounds, ElementBounds, SpringBounds};

@@ -18,7 +18,7 @@ use counterpoise_balance::{
 use counterpoise_dynamics::{EvaluateOptions, Indicators, evaluate_unbalanced_grid};
 use counterpoise_model::{Model, ModelError};
 use counterpoise_optimise::{
-    Context, FinalReactionSolve, Objective, OptimiseOptions, optimise_all_reporting,
+    Context, FinalReactionSolve, LoopTorques, Objective, OptimiseOptions, optimise_all_reporting,
 };
 use counterpoise_report as report;
 use report::{PhaseTiming, RankingOptions, RunMetadata, RunResults};
@@ -360,6 +360,7 @@ impl<'m> Study<'m> {
                 max_nodes: search.max_nodes,
                 start_seed: search.seed.unwrap_or(defaults.start_seed),
                 final_reaction_solve: FinalReactionSolve::for_study(model, balanced),
+                loop_torques: LoopTorques::for_study(model, balanced),
                 ..defaults
             };
             let report = |p: counterpoise_optimise::StageProgress| {

@@ -21,7 +21,6 @@ use std::collections::BTreeSet;
 
 use counterpoise_balance::linear::solve;
 use counterpoise_balance::{Status, VariantResult};
-use counterpoise_dynamics::Combination;
 use nalgebra::DVector;
 use rayon::prelude::*;
 
@@ -42,7 +41,7 @@ use state::*;
 
 pub use grid::objective_of;
 pub use peaks::{delta_r, lowest_delta_r};
-pub use state::{FinalReactionSolve, OptimiseOptions, StageTimings};
+pub use state::{FinalReactionSolve, LoopTorques, OptimiseOptions, StageTimings};
 
 /// Optimises one balanced variant (see [`optimise_all`]).
 pub fn optimise_variant(
@@ -174,8 +173,13 @@ fn critical_task_loop(
             evaluated.len(),
         );
         let dyn_variants = candidate_variants(&ctx.model, runs, &evaluated);
-        // without reactions the combination does not matter
-        let indicators = grid_indicators(ctx, &dyn_variants, false, Combination::Direct, &share);
+        let indicators = grid_indicators(
+            ctx,
+            &dyn_variants,
+            false,
+            options.loop_torques.combination(),
+            &share,
+        );
         timings.loop_grid += started.elapsed();
         let indicators = match indicators {
             Ok(i) => i,

@@ -29,6 +29,11 @@ pub struct OptimiseOptions {
     /// ([`FinalReactionSolve::for_study`]) so that every shard makes the same choice.
     #[serde(default)]
     pub final_reaction_solve: FinalReactionSolve,
+    /// How the critical-task loop's all-task evaluations (motor torques only) combine their
+    /// batch; set, like the final solve, from the whole balance search
+    /// ([`LoopTorques::for_study`]).
+    #[serde(default)]
+    pub loop_torques: LoopTorques,
     /// clarabel iteration limit.
     pub solver_iterations: u32,
     /// Boxes the certified search ([`crate::certify`]) solves at most per variant and pass: the
@@ -90,6 +95,52 @@ impl FinalReactionSolve {
     }
 }
 
+/// How the critical-task loop's all-task evaluations combine a batch's motor torques.
+///
+/// Torques are linear in the lifted parameters, and a variant differs from the robot in its
+/// elements' rows only: by superposition a sample solves the robot and one unit column per
+/// row that the batch changes, and each variant is a sum over its own rows (at Dmax 3 on the
+/// palletizer about 30 of them, against one wrench and actuator solve per variant and three
+/// per inertia group directly). It pays once a batch holds more variants than the rows they
+/// touch: on the palletizer's 788 feasible Dmax 3 designs, torques over all tasks take 2.9 s
+/// by superposition against 5.2 s directly, on every fourth of them (197) 1.27 s against
+/// 1.56 s, on every eighth (99) 1.08 s against 0.85 s (release, 2 cores;
+/// `crates/dynamics/examples/time_final.rs`). A study's first pass evaluates about as many
+/// variants as it has balanced ones and later passes a fraction of those (Dmax 3: 1169
+/// balanced, 248 in the second pass), so [`Self::for_study`] switches at `60·L` balanced
+/// variants (480 for the palletizer's 8 bodies: Dmax 2's 97 below, Dmax 3's 1169 above). The
+/// two give the same indicators to rounding; a variant's bits do not depend on its batch
+/// under either, only on this choice, which every shard of a study makes alike.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LoopTorques {
+    /// Every variant's own wrench and actuator solves (small batches).
+    #[default]
+    Direct,
+    /// The robot's and the changed rows' unit columns, summed per variant (large batches).
+    Superposition,
+}
+
+impl LoopTorques {
+    /// The choice for a study whose balance search found `balanced` variants (the same in
+    /// every shard).
+    pub fn for_study(model: &counterpoise_model::Model, balanced: usize) -> Self {
+        if balanced <= 60 * model.bodies.len() {
+            LoopTorques::Direct
+        } else {
+            LoopTorques::Superposition
+        }
+    }
+
+    /// The dynamics crate's way of combining a batch that makes this choice.
+    pub fn combination(self) -> counterpoise_dynamics::Combination {
+        match self {
+            LoopTorques::Direct => counterpoise_dynamics::Combination::Direct,
+            LoopTorques::Superposition => counterpoise_dynamics::Combination::Superposition,
+        }
+    }
+}
+
 pub(super) fn default_start_seed() -> u64 {
     crate::springs::DEFAULT_SEED
 }
@@ -119,6 +170,7 @@ impl Default for OptimiseOptions {
             spring_starts: 8,
             final_reactions: true,
             final_reaction_solve: FinalReactionSolve::default(),
+            loop_torques: LoopTorques::default(),
             solver_iterations: 200,
             max_nodes: crate::certify::DEFAULT_MAX_NODES,
             start_seed: crate::springs::DEFAULT_SEED,

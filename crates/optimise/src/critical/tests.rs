@@ -930,6 +930,28 @@ fn the_final_reaction_solve_follows_the_study_size() {
     );
 }
 
+/// The critical-task loop's torques follow the study's balanced count: directly up to 60·L
+/// balanced variants (480 for the palletizer's 8 bodies), by superposition above, so Dmax 2
+/// (97) keeps the direct solve and Dmax 3 (1169) sums; the default is direct.
+#[test]
+fn the_loop_torques_follow_the_study_size() {
+    let model = model(&case_json("palletizer.json"));
+    let choice = |n| LoopTorques::for_study(&model, n);
+    assert_eq!(choice(97), LoopTorques::Direct);
+    assert_eq!(choice(480), LoopTorques::Direct);
+    assert_eq!(choice(481), LoopTorques::Superposition);
+    assert_eq!(choice(1169), LoopTorques::Superposition);
+    assert_eq!(
+        LoopTorques::Direct.combination(),
+        counterpoise_dynamics::Combination::Direct
+    );
+    assert_eq!(
+        LoopTorques::Superposition.combination(),
+        counterpoise_dynamics::Combination::Superposition
+    );
+    assert_eq!(OptimiseOptions::default().loop_torques, LoopTorques::Direct);
+}
+
 /// The part of a spring's coupling error a split must remove (`certify::coupling`), from the
 /// palletizer's geometry (`docs/palletizer.md`). K54 joins upper_arm and front_link, which both
 /// turn by θ3: `a·R(0)·b` is constant, so W never enters the energy and every error is free
