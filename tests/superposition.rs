@@ -1,8 +1,10 @@
 //! Joint reactions and motor torques by superposition against the direct solve, on every
 //! feasible variant of the palletizer at Dmax 2 (issue 29): the dynamics crate's
 //! `Combination::Superposition` sums the model's outputs and its elements' unit-row outputs;
-//! `Combination::Direct` solves each variant's own right-hand side. The two are independent
-//! computations of the same linear map, so every peak must agree to rounding.
+//! `Combination::Direct` solves each variant's own right-hand side;
+//! `Combination::InertiaSuperposition` solves each variant directly and sums only its inertia
+//! group's changes with the rotation speed. They are independent computations of the same
+//! linear map, so every peak must agree to rounding.
 
 mod common;
 
@@ -62,38 +64,45 @@ fn every_reaction_peak_of_every_feasible_dmax2_variant_equals_the_direct_solve()
         grid.indicators
     };
     let direct = run(Combination::Direct);
-    let superposed = run(Combination::Superposition);
     let mut worst: f64 = 0.0;
     let mut compared = 0;
-    for (d, s) in direct.iter().zip(&superposed) {
-        // a peak below 1e-9 of the variant's largest joint force or moment is zero to rounding
-        let floor = d
-            .joints
-            .iter()
-            .map(|j| j.force.max(j.moment))
-            .fold(0.0, f64::max)
-            * 1e-9;
-        assert!(floor > 0.0);
-        assert_eq!(d.joints.len(), s.joints.len());
-        for (a, b) in d.joints.iter().zip(&s.joints) {
-            for (x, y) in [(a.force, b.force), (a.moment, b.moment)] {
-                let r = relative(x, y, floor);
-                worst = worst.max(r);
-                compared += 1;
-                assert!(r <= 1e-9, "{}: {x} direct, {y} superposed", a.name);
+    // Every variant summed over the basis, and every variant direct with its inertia group's
+    // changes summed.
+    for other in [
+        Combination::Superposition,
+        Combination::InertiaSuperposition,
+    ] {
+        let superposed = run(other);
+        for (d, s) in direct.iter().zip(&superposed) {
+            // a peak below 1e-9 of the variant's largest joint force or moment is zero to rounding
+            let floor = d
+                .joints
+                .iter()
+                .map(|j| j.force.max(j.moment))
+                .fold(0.0, f64::max)
+                * 1e-9;
+            assert!(floor > 0.0);
+            assert_eq!(d.joints.len(), s.joints.len());
+            for (a, b) in d.joints.iter().zip(&s.joints) {
+                for (x, y) in [(a.force, b.force), (a.moment, b.moment)] {
+                    let r = relative(x, y, floor);
+                    worst = worst.max(r);
+                    compared += 1;
+                    assert!(r <= 1e-9, "{}: {x} direct, {y} superposed", a.name);
+                }
+            }
+            // the motor torques are summed the same way (QTR, QIT and each actuator's RMS and peak)
+            for (x, y) in [(d.qtr, s.qtr), (d.qit, s.qit)] {
+                assert!(relative(x, y, 0.0) <= 1e-9, "{x} direct, {y} superposed");
+            }
+            for (a, b) in d.actuators.iter().zip(&s.actuators) {
+                assert!(relative(a.crt_rms, b.crt_rms, 0.0) <= 1e-9);
+                assert!(relative(a.cpt_peak, b.cpt_peak, 0.0) <= 1e-9);
             }
         }
-        // the motor torques are summed the same way (QTR, QIT and each actuator's RMS and peak)
-        for (x, y) in [(d.qtr, s.qtr), (d.qit, s.qit)] {
-            assert!(relative(x, y, 0.0) <= 1e-9, "{x} direct, {y} superposed");
-        }
-        for (a, b) in d.actuators.iter().zip(&s.actuators) {
-            assert!(relative(a.crt_rms, b.crt_rms, 0.0) <= 1e-9);
-            assert!(relative(a.cpt_peak, b.cpt_peak, 0.0) <= 1e-9);
-        }
     }
-    // 50 variants × 11 joints × (force, moment)
-    assert_eq!(compared, 50 * 11 * 2);
+    // 50 variants × 11 joints × (force, moment), two ways
+    assert_eq!(compared, 2 * 50 * 11 * 2);
     eprintln!("largest relative difference of a reaction peak: {worst:.1e}");
 }
 
@@ -139,8 +148,14 @@ fn a_superposed_column_is_the_same_bits_in_any_batch() {
         },
     ];
     // With the reactions (the final evaluation) and without (the critical-task loop's
-    // all-task torques, `LoopTorques` in the optimiser).
-    for reactions in [true, false] {
+    // all-task torques, `LoopTorques` in the optimiser); every variant summed, or only the
+    // inertia groups' changes (`InertiaSuperposition`, the final evaluation of a large study).
+    for (reactions, combination) in [
+        (true, Combination::Superposition),
+        (false, Combination::Superposition),
+        (true, Combination::InertiaSuperposition),
+        (false, Combination::InertiaSuperposition),
+    ] {
         let options = EvaluateOptions {
             reactions,
             ..EvaluateOptions::default()
@@ -148,7 +163,7 @@ fn a_superposed_column_is_the_same_bits_in_any_batch() {
         let evaluate = |members: &[usize]| -> Vec<Indicators> {
             let batch: Vec<Variant> = members.iter().map(|&k| variants[k].clone()).collect();
             let params = ParameterSet::from_variants(&model, &batch).unwrap();
-            evaluate_grid_indicators_with(&model, &params, &options, Combination::Superposition)
+            evaluate_grid_indicators_with(&model, &params, &options, combination)
                 .unwrap()
                 .indicators
         };
@@ -157,7 +172,7 @@ fn a_superposed_column_is_the_same_bits_in_any_batch() {
             for (&k, ind) in subset.iter().zip(evaluate(&subset)) {
                 assert!(
                     ind == all[k],
-                    "variant {k} differs in batch {subset:?} (reactions {reactions})"
+                    "variant {k} differs in batch {subset:?} ({combination:?}, reactions {reactions})"
                 );
             }
         }

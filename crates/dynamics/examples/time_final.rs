@@ -1,6 +1,6 @@
 //! The final all-task evaluation of a study's feasible designs, timed per way of combining
 //! the reactions: `cargo run --release -p counterpoise-dynamics --example time_final --
-//! RESULTS.json [direct|superposition|substitution] [samples=N] [torques] [step=K] [dump=PATH]` (the palletizer case; `torques`
+//! RESULTS.json [direct|superposition|substitution|inertia] [samples=N] [torques] [step=K] [dump=PATH]` (the palletizer case; `torques`
 //! leaves the reactions out; prints the wall time and a checksum of every peak, to compare
 //! the ways; `dump` writes the peaks).
 
@@ -19,6 +19,7 @@ fn main() {
     let combination = match args.get(2).map(String::as_str) {
         Some("superposition") => Combination::Superposition,
         Some("substitution") => Combination::Substitution,
+        Some("inertia") => Combination::InertiaSuperposition,
         _ => Combination::Direct,
     };
     let samples = args.iter().find_map(|a| {

@@ -54,4 +54,10 @@ pub enum Combination {
     /// palletizer's 92 right-hand sides per sample, 2.08 s against 2.28 s). The same values to
     /// rounding; a column's bits do not depend on the rest of the batch, only on this choice.
     Substitution,
+    /// Every column as [`Combination::Direct`] at `Δ = 0`, but the inertia groups' changes
+    /// with the rotation speed by superposition: the model's own inertia and one unit column
+    /// per inertial row that some group changes are evaluated, and each group's change is
+    /// their sum over its own rows (in ascending order, so a column's bits do not depend on
+    /// its batch). Pays when a batch holds many inertia groups (every hybrid variant is one).
+    InertiaSuperposition,
 }

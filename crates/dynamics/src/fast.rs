@@ -83,8 +83,17 @@ struct Work {
     /// `[Δ = 0 | unused | change to +1 | change to −1]`, `cols` each (the layout of `out` with
     /// every column its own group).
     sum_out: Vec<f64>,
-    /// With [`Superposition`]: the buffers of its sums.
+    /// With [`Superposition`] or [`InertiaSums`]: the buffers of the sums.
     sums: SumScratch,
+    /// With [`InertiaSums`]: the basis's torque changes to `Δ = ±1`, `[±][actuator][basis]`.
+    basis_changes: Vec<f64>,
+    /// With [`InertiaSums`]: every group's torque changes, `[±][actuator][group]`.
+    group_torque_changes: Vec<f64>,
+    /// With [`InertiaSums`]: zeros, one per group.
+    no_change: Vec<f64>,
+    /// With [`InertiaSums`]: every group's reaction component changes,
+    /// `[component row][+1 groups | −1 groups]`.
+    group_changes: Vec<f64>,
     /// Coefficients of the current sub-task, per sample (`stride` values): the motor torques
     /// as quadratics in `Δ` — three arrays `[actuator][column]` — then, with reactions,
     /// `|F_j|²` and `|M_j|²` as quartics — five arrays `[force/moment][joint][column]`.
@@ -249,6 +258,8 @@ pub(crate) fn evaluate_cyclic(
     let groups = InertiaGroups::new(params);
     let superposition = (combination == Combination::Superposition)
         .then(|| Superposition::new(&crate::params::model_body_params(ev.model), params));
+    let inertia_sums = (combination == Combination::InertiaSuperposition)
+        .then(|| InertiaSums::new(&crate::params::model_body_params(ev.model), &groups));
     let one_sub_task = |work: &mut Work, st: usize, floor: Option<&[f64]>| -> SubTaskOutcome {
         let (s1, s2) = st_pairs[st];
         let data = match &sub_q[s1] {
@@ -264,6 +275,7 @@ pub(crate) fn evaluate_cyclic(
                 params,
                 &groups,
                 superposition.as_ref(),
+                inertia_sums.as_ref(),
                 combination == Combination::Substitution,
                 with_reactions,
                 per_sample_stride,
@@ -534,6 +546,7 @@ fn sub_task(
     params: &ParameterSet,
     groups: &InertiaGroups,
     superposition: Option<&Superposition>,
+    inertia_sums: Option<&InertiaSums>,
     substitute: bool,
     with_reactions: bool,
     stride: usize,
@@ -562,7 +575,12 @@ fn sub_task(
     let rows = 6 * l;
     let tq = n * cols;
     let rq = 2 * nj * out_cols;
-    let nreps = groups.rep_batch.len();
+    // The representatives evaluated at every Δ: the groups', or the basis of their sums.
+    let (rep_batch, rep_slots) = match inertia_sums {
+        Some(sums) => (&sums.batch, &sums.basis.springs),
+        None => (&groups.rep_batch, &groups.rep_params.springs),
+    };
+    let nreps = rep_batch.len();
     // right-hand sides solved: every column at Δ = 0, the representatives at Δ = 0, ±1
     let solved = cols + 3 * nreps;
     work.coefficients.resize(ns * stride, 0.0);
@@ -621,7 +639,7 @@ fn sub_task(
             // Every column at Δ = 0; the representatives at every Δ. One wrench regressor per
             // body serves all the columns of a batch, whatever its size, so that a column's
             // arithmetic is the same in every batch.
-            let representatives = (true, &groups.rep_batch);
+            let representatives = (true, rep_batch);
             let jobs: &[(bool, &ColumnBatch)] = if si == 0 {
                 &[(false, &groups.all), representatives]
             } else {
@@ -631,11 +649,7 @@ fn sub_task(
                 let nc = batch.len();
                 // the batch's first right-hand side among those solved
                 let first = if is_rep { cols + si * nreps } else { 0 };
-                let slots = if is_rep {
-                    &groups.rep_params.springs
-                } else {
-                    &params.springs
-                };
+                let slots = if is_rep { rep_slots } else { &params.springs };
                 // The wrenches go straight into the batch's block of the right-hand sides
                 // (rows `solved` apart), or into a buffer of their own without reactions.
                 let (w, row_stride) = if with_reactions {
@@ -714,7 +728,43 @@ fn sub_task(
         work.scratch.pose = pose;
         // Every (evaluated) column at Δ = ±1 from its representative:
         // X_p(±1) = X_r(±1) + X_p(0) − X_r(0).
-        {
+        if let Some(sums) = inertia_sums {
+            // X_p(±1) = X_p(0) + D_g(±), the group's change summed over the basis's changes.
+            let ng = sums.groups();
+            work.basis_changes.resize(2 * n * nreps, 0.0);
+            for side in 0..2 {
+                for a in 0..n {
+                    let at = |d: usize| &work.rep_torques[(d * n + a) * nreps..][..nreps];
+                    let (to, zero) = (at(side + 1), at(0));
+                    let dst = &mut work.basis_changes[(side * n + a) * nreps..][..nreps];
+                    for ((d, &x), &z) in dst.iter_mut().zip(to).zip(zero) {
+                        *d = x - z;
+                    }
+                }
+            }
+            work.group_torque_changes.resize(2 * n * ng, 0.0);
+            sums.changes(
+                &work.basis_changes,
+                nreps,
+                0,
+                2 * n,
+                &mut work.group_torque_changes,
+                ng,
+                0,
+                &mut work.sums,
+            );
+            work.no_change.clear();
+            work.no_change.resize(ng, 0.0);
+            let (at_zero, at_pm) = work.torques.split_at_mut(tq);
+            for si in 0..2 {
+                for a in 0..n {
+                    let zero = &at_zero[a * cols..(a + 1) * cols];
+                    let change = &work.group_torque_changes[(si * n + a) * ng..][..ng];
+                    let dst = &mut at_pm[(si * n + a) * cols..(si * n + a + 1) * cols];
+                    groups.expand(dst, change, zero, &work.no_change);
+                }
+            }
+        } else {
             let (at_zero, at_pm) = work.torques.split_at_mut(tq);
             for si in 0..2 {
                 for a in 0..n {
@@ -724,6 +774,25 @@ fn sub_task(
                     let dst = &mut at_pm[(si * n + a) * cols..(si * n + a + 1) * cols];
                     groups.expand(dst, reps(si + 1), zero, reps(0));
                 }
+            }
+        }
+        // With inertia sums, every group's reaction changes to Δ = +1 and −1:
+        // `[component row][+1 groups | −1 groups]`.
+        if let (Some(sums), true) = (inertia_sums, with_reactions) {
+            let ng = sums.groups();
+            let len = 6 * nj;
+            work.group_changes.resize(len * 2 * ng, 0.0);
+            for side in 0..2 {
+                sums.changes(
+                    &work.out,
+                    solved,
+                    cols + (1 + side) * nreps,
+                    len,
+                    &mut work.group_changes,
+                    2 * ng,
+                    side * ng,
+                    &mut work.sums,
+                );
             }
         }
         // The stored columns' values: the evaluated ones, or their sums over the basis.
@@ -747,12 +816,22 @@ fn sub_task(
             ),
         };
         let tq = n * cols;
+        // Each component row's groups' changes to Δ = +1 and −1.
+        let ng = inertia_sums.map_or(nreps, InertiaSums::groups);
+        let changes_of = |row: usize| -> (&[f64], &[f64]) {
+            let both = match inertia_sums {
+                Some(_) => &work.group_changes[row * 2 * ng..(row + 1) * 2 * ng],
+                None => &out[row * solved + cols + nreps..(row + 1) * solved],
+            };
+            both.split_at(ng)
+        };
         let mut finite = all_finite(torques);
         if with_reactions {
             // every column at Δ = 0 and every group's change
             for row in 0..6 * nj {
+                let (plus, minus) = changes_of(row);
                 finite &= all_finite(&out[row * solved..row * solved + cols]);
-                finite &= all_finite(&out[row * solved + cols + nreps..(row + 1) * solved]);
+                finite &= all_finite(plus) && all_finite(minus);
             }
         }
         if !finite {
@@ -778,10 +857,9 @@ fn sub_task(
                     // the three components: every column at Δ = 0, the groups' changes to
                     // Δ = +1 and −1
                     let component = |r: usize| {
-                        let row = &out[(6 * j + 3 * part + r) * solved..][..solved];
-                        let (x0, rest) = row.split_at(cols);
-                        let changes = &rest[nreps..];
-                        let (plus, minus) = changes.split_at(nreps);
+                        let row = 6 * j + 3 * part + r;
+                        let x0 = &out[row * solved..][..cols];
+                        let (plus, minus) = changes_of(row);
                         [x0, plus, minus]
                     };
                     squared_norm_quartic(

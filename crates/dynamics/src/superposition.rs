@@ -206,6 +206,94 @@ impl Superposition {
     }
 }
 
+/// The inertia groups' changes with `Δ` by superposition (`Combination::InertiaSuperposition`).
+///
+/// A group's change from `Δ = 0` to `Δ = ±1` is linear in its inertial parameters and
+/// independent of springs; a group differs from the model's own inertia `p₀` only in the
+/// bodies its counterweights load. Per sample the machinery evaluates `p₀` and one unit column
+/// per inertial row in which some group differs (the basis, spring-free, as a batch of
+/// representatives), and each group's change is `D(p₀) + Σ (p_r − p₀_r) D(e_r)` over its own
+/// rows in ascending order — the same bits whatever the batch, as [`Superposition`]'s sums.
+/// Every column itself is still evaluated directly at `Δ = 0`. It pays when a batch holds many
+/// inertia groups (each hybrid variant its own): three right-hand sides per group become
+/// three per basis column and a short sum.
+pub(crate) struct InertiaSums {
+    /// `p₀` and the unit columns, spring-free, in row order.
+    pub(crate) basis: ParameterSet,
+    pub(crate) batch: ColumnBatch,
+    /// Per group: `(basis column, p_r − p₀_r)` over the rows where its inertia differs,
+    /// ascending.
+    terms: Vec<Vec<(u32, f64)>>,
+}
+
+impl InertiaSums {
+    pub(crate) fn new(base_bodies: &[f64], groups: &InertiaGroups) -> InertiaSums {
+        let reps = &groups.rep_params;
+        let rows = reps.rows();
+        let inertial_rows = crate::params::BODY_PARAMS * reps.bodies;
+        let mut base = base_bodies.to_vec();
+        base.resize(rows, 0.0);
+        let differs = |g: usize, r: usize| reps.column(g)[r].to_bits() != base[r].to_bits();
+        let used: Vec<usize> = (0..inertial_rows)
+            .filter(|&r| (0..reps.len()).any(|g| differs(g, r)))
+            .collect();
+        let mut basis = ParameterSet::empty(reps.bodies, reps.springs.clone());
+        basis
+            .push_column(&base)
+            .expect("a column of the set's own shape");
+        let mut index = vec![u32::MAX; rows];
+        for &r in &used {
+            let mut unit = vec![0.0; rows];
+            unit[r] = 1.0;
+            basis
+                .push_column(&unit)
+                .expect("a column of the set's own shape");
+            index[r] = (basis.len() - 1) as u32;
+        }
+        let terms = (0..reps.len())
+            .map(|g| {
+                used.iter()
+                    .filter(|&&r| differs(g, r))
+                    .map(|&r| (index[r], reps.column(g)[r] - base[r]))
+                    .collect()
+            })
+            .collect();
+        let all: Vec<usize> = (0..basis.len()).collect();
+        InertiaSums {
+            batch: ColumnBatch::new(&basis, &all),
+            basis,
+            terms,
+        }
+    }
+
+    /// The number of groups.
+    pub(crate) fn groups(&self) -> usize {
+        self.terms.len()
+    }
+
+    /// Every group's changes of `len` values, `dst[r·stride + offset + g]`, from the basis's
+    /// changes `src[r·src_stride + from + k]`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn changes(
+        &self,
+        src: &[f64],
+        src_stride: usize,
+        from: usize,
+        len: usize,
+        dst: &mut [f64],
+        stride: usize,
+        offset: usize,
+        scratch: &mut SumScratch,
+    ) {
+        let (nb, ng) = (self.basis.len(), self.terms.len());
+        let width = len.next_multiple_of(8);
+        transpose_into(&mut scratch.basis, src, len, width, nb, src_stride, from);
+        scratch.sums.resize(ng * width, 0.0);
+        sum_vectors(&self.terms, 0, &scratch.basis, width, &mut scratch.sums);
+        transpose_from(dst, &scratch.sums, len, width, ng, stride, offset);
+    }
+}
+
 /// Buffers of [`Superposition`]'s sums, reused from sample to sample.
 #[derive(Default)]
 pub(crate) struct SumScratch {

@@ -59,6 +59,16 @@ pub struct OptimiseOptions {
 /// substitution takes 2.08 s against the operator's 2.28 s; at Dmax 3 (788 finalists) the
 /// operator takes 25.8 s against substitution's 29.3 s. [`Self::for_study`] switches at
 /// `2.5 · 6L` balanced variants, on the Dmax 2 side of that range.
+///
+/// A large batch holds many inertia groups too (every variant with a counterweight is its
+/// own: 418 for the 788 Dmax 3 finalists), each evaluated at three rotation speeds; by
+/// superposition over the inertial rows the groups touch they cost three right-hand sides per
+/// basis column (61 at Dmax 3) and a short sum each
+/// ([`counterpoise_dynamics::Combination::InertiaSuperposition`]). On the 788 Dmax 3 designs'
+/// final grid that takes 20.0 s against the operator's 23.4 s, on every fourth of them (197,
+/// 11 samples per move) 1.40 s against 1.54 s, on every eighth (99) 0.85 s against 0.78 s
+/// (release, 2 cores; `crates/dynamics/examples/time_final.rs`), so it takes over at the
+/// loop's threshold ([`LoopTorques::for_study`], `60·L` balanced variants).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FinalReactionSolve {
@@ -68,6 +78,9 @@ pub enum FinalReactionSolve {
     /// By substitution in the sample's factorisation, right-hand side by right-hand side
     /// (small batches).
     Substitution,
+    /// Through the operator, the inertia groups' changes by superposition (the largest
+    /// batches).
+    OperatorInertiaSums,
 }
 
 impl FinalReactionSolve {
@@ -81,8 +94,10 @@ impl FinalReactionSolve {
         let crossover = 15 * model.bodies.len();
         if balanced <= crossover {
             FinalReactionSolve::Substitution
-        } else {
+        } else if LoopTorques::for_study(model, balanced) == LoopTorques::Direct {
             FinalReactionSolve::Operator
+        } else {
+            FinalReactionSolve::OperatorInertiaSums
         }
     }
 
@@ -91,6 +106,9 @@ impl FinalReactionSolve {
         match self {
             FinalReactionSolve::Operator => counterpoise_dynamics::Combination::Direct,
             FinalReactionSolve::Substitution => counterpoise_dynamics::Combination::Substitution,
+            FinalReactionSolve::OperatorInertiaSums => {
+                counterpoise_dynamics::Combination::InertiaSuperposition
+            }
         }
     }
 }

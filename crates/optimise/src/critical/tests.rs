@@ -904,9 +904,9 @@ fn boxes_solved_together_are_the_boxes_solved_alone() {
 }
 
 /// The final evaluation's reaction solve follows the study's balanced count: substitution up
-/// to 2.5 · 6L balanced variants (the palletizer's 8 bodies: 120), the operator above. The
-/// palletizer's searches fall on either side: 97 balanced variants at Dmax 2, 1169 at Dmax 3
-/// (the counts `variants` lists).
+/// to 2.5 · 6L balanced variants (the palletizer's 8 bodies: 120), the operator above, with
+/// the inertia groups' changes summed above 60·L (480). The palletizer's searches fall on
+/// either side: 97 balanced variants at Dmax 2, 1169 at Dmax 3 (the counts `variants` lists).
 #[test]
 fn the_final_reaction_solve_follows_the_study_size() {
     let model = model(&case_json("palletizer.json"));
@@ -915,7 +915,13 @@ fn the_final_reaction_solve_follows_the_study_size() {
     assert_eq!(choice(97), FinalReactionSolve::Substitution);
     assert_eq!(choice(120), FinalReactionSolve::Substitution);
     assert_eq!(choice(121), FinalReactionSolve::Operator);
-    assert_eq!(choice(1169), FinalReactionSolve::Operator);
+    assert_eq!(choice(480), FinalReactionSolve::Operator);
+    assert_eq!(choice(481), FinalReactionSolve::OperatorInertiaSums);
+    assert_eq!(choice(1169), FinalReactionSolve::OperatorInertiaSums);
+    assert_eq!(
+        FinalReactionSolve::OperatorInertiaSums.combination(),
+        counterpoise_dynamics::Combination::InertiaSuperposition
+    );
     assert_eq!(
         FinalReactionSolve::Substitution.combination(),
         counterpoise_dynamics::Combination::Substitution
