@@ -137,3 +137,71 @@ fn a_batch_by_substitution_matches_the_operator_and_each_column_alone() {
         );
     }
 }
+
+/// The sums by superposition against the direct solve, on the batch above (two inertia
+/// groups, counterweights and springs): the final evaluation of a large study sums its
+/// inertia groups' changes with the rotation speed (`Combination::InertiaSuperposition`), and
+/// its critical-task loop sums every column's torques (`Combination::Superposition` without
+/// reactions). Every joint reaction peak and every motor torque figure agrees with the direct
+/// solve's to 1e-12 relative (the second method), and each column evaluated alone has the same
+/// bits as in the batch.
+#[test]
+fn the_sums_by_superposition_match_the_direct_solve_and_each_column_alone() {
+    let model = coarse_palletizer();
+    let variants = variants(&model);
+    let params = ParameterSet::from_variants(&model, &variants).unwrap();
+    // relative to the larger of the two, or to `floor` (a joint that carries nothing is an
+    // exact zero one way and a rounding residue the other)
+    let near =
+        |x: f64, y: f64, floor: f64| (x - y).abs() <= 1e-12 * x.abs().max(y.abs()).max(floor);
+    let close = |x: f64, y: f64| near(x, y, 0.0);
+    for (reactions, combination) in [
+        (true, Combination::InertiaSuperposition),
+        (false, Combination::Superposition),
+        (true, Combination::Superposition),
+    ] {
+        let options = EvaluateOptions {
+            reactions,
+            ..EvaluateOptions::default()
+        };
+        let evaluate = |params: &ParameterSet, combination| {
+            evaluate_grid_indicators_with(&model, params, &options, combination)
+                .unwrap()
+                .indicators
+        };
+        let direct = evaluate(&params, Combination::Direct);
+        let summed = evaluate(&params, combination);
+        for (c, (a, b)) in direct.iter().zip(&summed).enumerate() {
+            assert_eq!(a.joints.len(), if reactions { 11 } else { 0 });
+            let floor = a
+                .joints
+                .iter()
+                .map(|j| j.force.max(j.moment))
+                .fold(0.0, f64::max);
+            for (ja, jb) in a.joints.iter().zip(&b.joints) {
+                for (x, y) in [(ja.force, jb.force), (ja.moment, jb.moment)] {
+                    assert!(near(x, y, floor), "{combination:?} {c}: {x} {y}");
+                }
+            }
+            assert!(
+                close(a.qtr, b.qtr) && close(a.qit, b.qit),
+                "{combination:?} {c}"
+            );
+            for (x, y) in a.actuators.iter().zip(&b.actuators) {
+                for (u, v) in [(x.crt_rms, y.crt_rms), (x.cpt_peak, y.cpt_peak)] {
+                    assert!(close(u, v), "{combination:?} {c}: {u} {v}");
+                }
+            }
+        }
+        // the elements change the figures: the comparison is not of three copies
+        assert!(summed[1].qtr != summed[0].qtr && summed[2].qtr != summed[0].qtr);
+        for (c, variant) in variants.iter().enumerate() {
+            let alone = ParameterSet::from_variants(&model, std::slice::from_ref(variant)).unwrap();
+            assert_eq!(
+                evaluate(&alone, combination)[0],
+                summed[c],
+                "{combination:?} {c}"
+            );
+        }
+    }
+}
