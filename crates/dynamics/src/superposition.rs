@@ -458,8 +458,17 @@ mod tests {
 
     #[test]
     fn the_vector_sums_are_the_scalar_folds() {
-        // Two bodies, a spring slot; columns differing from the base in body rows (inertial)
-        // and spring rows, some in several rows, one not at all.
+        // Few columns and short vectors (one block in registers), then more columns and basis
+        // columns than a transpose tile and vectors longer than the registers hold.
+        check_sums(0, 11);
+        check_sums(40, 90);
+    }
+
+    /// Superposition's sums against the scalar folds, on columns that differ from the base in
+    /// body rows (inertial) and spring rows, some in several rows, one not at all, and `extra`
+    /// more, over `len` component rows.
+    fn check_sums(extra: usize, len: usize) {
+        // Two bodies, a spring slot.
         let bodies = 2;
         let slot = crate::params::SpringSlot {
             body: 0,
@@ -477,13 +486,15 @@ mod tests {
             x = (x * 3.7 + 0.11).fract();
             x - 0.5
         };
-        for changed in [
+        let mut changes = vec![
             vec![],
             vec![0],
             vec![3, 12],
             vec![rows - 1],
             vec![1, 5, rows - 2],
-        ] {
+        ];
+        changes.extend((0..extra).map(|i| vec![i % rows, (7 * i + 3) % rows]));
+        for changed in changes {
             let mut column = full.clone();
             for r in changed {
                 column[r] += next();
@@ -494,7 +505,9 @@ mod tests {
         let nb = sup.basis.len();
         let nreps = sup.groups.rep_batch.len();
         assert!(nreps >= 3, "inertial unit columns are groups of their own");
-        let len = 11;
+        if extra > 0 {
+            assert!(nb > TILE && params.len() > TILE && len > 72);
+        }
         let solved = nb + 3 * nreps + 2;
         let out: Vec<f64> = (0..len * solved).map(|_| next() * 1e3).collect();
         let mut dst = Vec::new();
