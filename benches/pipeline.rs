@@ -8,8 +8,9 @@
 //! - `grid/unbalanced_reactions`: the full-grid evaluation of the unbalanced robot with joint
 //!   reactions (Phase 1);
 //! - `final_grid/*`: the final all-task evaluation (torques and reactions) of the 50 feasible
-//!   Dmax 2 designs, with the reactions solved per variant (`direct`) and by superposition
-//!   (`superposition`); and the same on 200 synthetic three-element variants (about as many
+//!   Dmax 2 designs, with the reactions solved per variant (`direct`), by superposition
+//!   (`superposition`), and per variant with the inertia groups' changes summed
+//!   (`inertia_sums`, a large study's final evaluation); and the same on 200 synthetic three-element variants (about as many
 //!   as the lifted rows they touch; Dmax 3 has 785 finalists), over which superposition's
 //!   fixed cost (one solve per lifted row the batch touches) is spread. At 11 and 5 samples per move
 //!   instead of the case's 51, to keep the set short.
@@ -149,6 +150,7 @@ fn pipeline(c: &mut Criterion) {
     for (name, combination) in [
         ("dmax2_direct", Combination::Direct),
         ("dmax2_superposition", Combination::Superposition),
+        ("dmax2_inertia_sums", Combination::InertiaSuperposition),
     ] {
         group.bench_function(name, |b| {
             b.iter(|| evaluate_grid_indicators_with(&model, &params, &options, combination))
@@ -164,6 +166,10 @@ fn pipeline(c: &mut Criterion) {
     for (name, combination) in [
         ("synthetic200_direct", Combination::Direct),
         ("synthetic200_superposition", Combination::Superposition),
+        (
+            "synthetic200_inertia_sums",
+            Combination::InertiaSuperposition,
+        ),
     ] {
         group.bench_function(name, |b| {
             b.iter(|| evaluate_grid_indicators_with(&model, &params, &options, combination))
