@@ -92,36 +92,11 @@ pub(crate) struct Superposition {
 
 impl Superposition {
     pub(crate) fn new(base_bodies: &[f64], params: &ParameterSet) -> Superposition {
-        let rows = params.rows();
+        let UnitBasis { basis, rows, terms } = UnitBasis::new(base_bodies, params);
         let inertial_rows = crate::params::BODY_PARAMS * params.bodies;
-        let mut base = base_bodies.to_vec();
-        base.resize(rows, 0.0);
-        let differs = |p: usize, r: usize| params.column(p)[r].to_bits() != base[r].to_bits();
-        let used: Vec<usize> = (0..rows)
-            .filter(|&r| (0..params.len()).any(|p| differs(p, r)))
-            .collect();
-        let mut basis = ParameterSet::empty(params.bodies, params.springs.clone());
-        basis
-            .push_column(&base)
-            .expect("a column of the set's own shape");
-        let mut inertial = vec![true];
-        let mut index = vec![u32::MAX; rows];
-        for &r in &used {
-            let mut unit = vec![0.0; rows];
-            unit[r] = 1.0;
-            basis
-                .push_column(&unit)
-                .expect("a column of the set's own shape");
-            index[r] = (basis.len() - 1) as u32;
-            inertial.push(r < inertial_rows);
-        }
-        let terms: Vec<Vec<(u32, f64)>> = (0..params.len())
-            .map(|p| {
-                used.iter()
-                    .filter(|&&r| differs(p, r))
-                    .map(|&r| (index[r], params.column(p)[r] - base[r]))
-                    .collect()
-            })
+        // per basis column: `p₀` and the body rows change with Δ, spring rows do not
+        let inertial: Vec<bool> = std::iter::once(true)
+            .chain(rows.iter().map(|&r| r < inertial_rows))
             .collect();
         let groups = InertiaGroups::new(&basis);
         let change_terms = terms
@@ -228,36 +203,8 @@ pub(crate) struct InertiaSums {
 
 impl InertiaSums {
     pub(crate) fn new(base_bodies: &[f64], groups: &InertiaGroups) -> InertiaSums {
-        let reps = &groups.rep_params;
-        let rows = reps.rows();
-        let inertial_rows = crate::params::BODY_PARAMS * reps.bodies;
-        let mut base = base_bodies.to_vec();
-        base.resize(rows, 0.0);
-        let differs = |g: usize, r: usize| reps.column(g)[r].to_bits() != base[r].to_bits();
-        let used: Vec<usize> = (0..inertial_rows)
-            .filter(|&r| (0..reps.len()).any(|g| differs(g, r)))
-            .collect();
-        let mut basis = ParameterSet::empty(reps.bodies, reps.springs.clone());
-        basis
-            .push_column(&base)
-            .expect("a column of the set's own shape");
-        let mut index = vec![u32::MAX; rows];
-        for &r in &used {
-            let mut unit = vec![0.0; rows];
-            unit[r] = 1.0;
-            basis
-                .push_column(&unit)
-                .expect("a column of the set's own shape");
-            index[r] = (basis.len() - 1) as u32;
-        }
-        let terms = (0..reps.len())
-            .map(|g| {
-                used.iter()
-                    .filter(|&&r| differs(g, r))
-                    .map(|&r| (index[r], reps.column(g)[r] - base[r]))
-                    .collect()
-            })
-            .collect();
+        // The representatives are spring-free: only their inertial rows can differ from `p₀`.
+        let UnitBasis { basis, terms, .. } = UnitBasis::new(base_bodies, &groups.rep_params);
         let all: Vec<usize> = (0..basis.len()).collect();
         InertiaSums {
             batch: ColumnBatch::new(&basis, &all),
@@ -291,6 +238,56 @@ impl InertiaSums {
         scratch.sums.resize(ng * width, 0.0);
         sum_vectors(&self.terms, 0, &scratch.basis, width, &mut scratch.sums);
         transpose_from(dst, &scratch.sums, len, width, ng, stride, offset);
+    }
+}
+
+/// The model's own parameters `p₀` (its bodies, no springs) and one unit column per row in
+/// which some column of a set differs from them, in row order, with each column as its
+/// differences from `p₀`.
+struct UnitBasis {
+    /// `p₀`, then the unit columns.
+    basis: ParameterSet,
+    /// The row of each unit column.
+    rows: Vec<usize>,
+    /// Per column: `(basis column, p_r − p₀_r)` over the rows where it differs, ascending.
+    terms: Vec<Vec<(u32, f64)>>,
+}
+
+impl UnitBasis {
+    fn new(base_bodies: &[f64], params: &ParameterSet) -> UnitBasis {
+        let rows = params.rows();
+        let mut base = base_bodies.to_vec();
+        base.resize(rows, 0.0);
+        let differs = |p: usize, r: usize| params.column(p)[r].to_bits() != base[r].to_bits();
+        let used: Vec<usize> = (0..rows)
+            .filter(|&r| (0..params.len()).any(|p| differs(p, r)))
+            .collect();
+        let mut basis = ParameterSet::empty(params.bodies, params.springs.clone());
+        basis
+            .push_column(&base)
+            .expect("a column of the set's own shape");
+        let mut index = vec![u32::MAX; rows];
+        for &r in &used {
+            let mut unit = vec![0.0; rows];
+            unit[r] = 1.0;
+            basis
+                .push_column(&unit)
+                .expect("a column of the set's own shape");
+            index[r] = (basis.len() - 1) as u32;
+        }
+        let terms = (0..params.len())
+            .map(|p| {
+                used.iter()
+                    .filter(|&&r| differs(p, r))
+                    .map(|&r| (index[r], params.column(p)[r] - base[r]))
+                    .collect()
+            })
+            .collect();
+        UnitBasis {
+            basis,
+            rows: used,
+            terms,
+        }
     }
 }
 
