@@ -60,10 +60,10 @@ pub struct OptimiseOptions {
 /// operator takes 25.8 s against substitution's 29.3 s. [`Self::for_study`] switches at
 /// `2.5 · 6L` balanced variants, on the Dmax 2 side of that range.
 ///
-/// A large batch holds many inertia groups too (every variant with a counterweight is its
-/// own: 418 for the 788 Dmax 3 finalists), each evaluated at three rotation speeds; by
-/// superposition over the inertial rows the groups touch they cost three right-hand sides per
-/// basis column (61 at Dmax 3) and a short sum each
+/// A large batch holds many inertia groups too (nearly every variant with a counterweight is
+/// its own: 344 groups for the 788 Dmax 3 finalists), each evaluated at three rotation speeds;
+/// by superposition over the inertial rows the groups touch they cost three right-hand sides
+/// per basis column (50 at Dmax 3) and a short sum each
 /// ([`counterpoise_dynamics::Combination::InertiaSuperposition`]). On the 788 Dmax 3 designs'
 /// final grid that takes 20.0 s against the operator's 23.4 s, on every fourth of them (197,
 /// 11 samples per move) 1.40 s against 1.54 s, on every eighth (99) 0.85 s against 0.78 s
@@ -117,10 +117,10 @@ impl FinalReactionSolve {
 ///
 /// Torques are linear in the lifted parameters, and a variant differs from the robot in its
 /// elements' rows only: by superposition a sample solves the robot and one unit column per
-/// row that the batch changes, and each variant is a sum over its own rows (at Dmax 3 on the
-/// palletizer about 30 of them, against one wrench and actuator solve per variant and three
-/// per inertia group directly). It pays once a batch holds more variants than the rows they
-/// touch: on the palletizer's 788 feasible Dmax 3 designs, torques over all tasks take 2.9 s
+/// row that the batch changes (239 for the 788 Dmax 3 designs), and each variant is a sum over
+/// its own rows (at most 27 at Dmax 3: 7 per counterweight in a plane, 9 per spring), against
+/// one wrench and actuator solve per variant and three per inertia group directly. It pays
+/// once a batch holds more variants than the rows they touch: on the palletizer's 788 feasible Dmax 3 designs, torques over all tasks take 2.9 s
 /// by superposition against 5.2 s directly, on every fourth of them (197) 1.27 s against
 /// 1.56 s, on every eighth (99) 1.08 s against 0.85 s (release, 2 cores;
 /// `crates/dynamics/examples/time_final.rs`). A study's first pass evaluates about as many
