@@ -127,12 +127,9 @@ impl Superposition {
         scratch: &mut SumScratch,
     ) {
         let (nb, cols, len) = (self.basis.len(), self.terms.len(), 3 * n);
-        let width = len.next_multiple_of(8);
         dst.resize(len * cols, 0.0);
-        transpose_into(&mut scratch.basis, basis, len, width, nb, nb, 0);
-        scratch.sums.resize(cols * width, 0.0);
-        sum_vectors(&self.terms, 0, &scratch.basis, width, &mut scratch.sums);
-        transpose_from(dst, &scratch.sums, len, width, cols, cols, 0);
+        let (src_at, dst_at) = (RowLayout::new(nb, 0), RowLayout::new(cols, 0));
+        scratch.sum(&self.terms, 0, len, (basis, nb, src_at), (dst, dst_at));
     }
 
     /// Every column's reaction components (the layout of `Work::sum_out`) from the basis's
@@ -157,26 +154,17 @@ impl Superposition {
             self.terms.len(),
         );
         let len = component_rows;
-        let width = len.next_multiple_of(8);
         dst.resize(len * 4 * cols, 0.0);
-        scratch.sums.resize(cols * width, 0.0);
         // Δ = 0: the basis columns.
-        transpose_into(&mut scratch.basis, out, len, width, nb, solved, 0);
-        sum_vectors(&self.terms, 0, &scratch.basis, width, &mut scratch.sums);
-        transpose_from(dst, &scratch.sums, len, width, cols, 4 * cols, 0);
+        let at_zero = (out, nb, RowLayout::new(solved, 0));
+        let into = RowLayout::new(4 * cols, 0);
+        scratch.sum(&self.terms, 0, len, at_zero, (dst, into));
         // The changes to Δ = +1 and −1: the groups' of the inertial terms.
         let first = self.groups.group[0] as usize;
         for (side, offset) in [(0, 2 * cols), (1, 3 * cols)] {
-            let from = nb + (1 + side) * nreps;
-            transpose_into(&mut scratch.basis, out, len, width, nreps, solved, from);
-            sum_vectors(
-                &self.change_terms,
-                first,
-                &scratch.basis,
-                width,
-                &mut scratch.sums,
-            );
-            transpose_from(dst, &scratch.sums, len, width, cols, 4 * cols, offset);
+            let changes = (out, nreps, RowLayout::new(solved, nb + (1 + side) * nreps));
+            let into = RowLayout::new(4 * cols, offset);
+            scratch.sum(&self.change_terms, first, len, changes, (dst, into));
         }
     }
 }
@@ -232,12 +220,9 @@ impl InertiaSums {
         offset: usize,
         scratch: &mut SumScratch,
     ) {
-        let (nb, ng) = (self.basis.len(), self.terms.len());
-        let width = len.next_multiple_of(8);
-        transpose_into(&mut scratch.basis, src, len, width, nb, src_stride, from);
-        scratch.sums.resize(ng * width, 0.0);
-        sum_vectors(&self.terms, 0, &scratch.basis, width, &mut scratch.sums);
-        transpose_from(dst, &scratch.sums, len, width, ng, stride, offset);
+        let basis = (src, self.basis.len(), RowLayout::new(src_stride, from));
+        let into = RowLayout::new(stride, offset);
+        scratch.sum(&self.terms, 0, len, basis, (dst, into));
     }
 }
 
@@ -300,6 +285,40 @@ pub(crate) struct SumScratch {
     sums: Vec<f64>,
 }
 
+/// Where values laid out row by row sit: row `r`'s value `k` at `r·stride + offset + k`.
+#[derive(Clone, Copy)]
+struct RowLayout {
+    stride: usize,
+    offset: usize,
+}
+
+impl RowLayout {
+    fn new(stride: usize, offset: usize) -> RowLayout {
+        RowLayout { stride, offset }
+    }
+}
+
+impl SumScratch {
+    /// Every column's sum over `len` rows: `dst`'s value `p` of row `r` is `src`'s value `first`
+    /// plus `c` times its value `k` over column `p`'s terms `(k, c)`, in their order (`src`
+    /// holds `count` values per row). The basis is transposed to one contiguous vector per
+    /// value, the sums taken as vectors ([`sum_vectors`]) and transposed back.
+    fn sum(
+        &mut self,
+        terms: &[Vec<(u32, f64)>],
+        first: usize,
+        len: usize,
+        (src, count, src_at): (&[f64], usize, RowLayout),
+        (dst, dst_at): (&mut [f64], RowLayout),
+    ) {
+        let width = len.next_multiple_of(8);
+        transpose_into(&mut self.basis, src, len, width, count, src_at);
+        self.sums.resize(terms.len() * width, 0.0);
+        sum_vectors(terms, first, &self.basis, width, &mut self.sums);
+        transpose_from(dst, &self.sums, len, width, terms.len(), dst_at);
+    }
+}
+
 /// Columns per tile of the transposes: a tile's vectors stay in the first-level cache while
 /// its rows are copied.
 const TILE: usize = 32;
@@ -312,8 +331,7 @@ fn transpose_into(
     len: usize,
     width: usize,
     count: usize,
-    stride: usize,
-    offset: usize,
+    RowLayout { stride, offset }: RowLayout,
 ) {
     dst.resize(count * width, 0.0);
     for k0 in (0..count).step_by(TILE) {
@@ -337,8 +355,7 @@ fn transpose_from(
     len: usize,
     width: usize,
     count: usize,
-    stride: usize,
-    offset: usize,
+    RowLayout { stride, offset }: RowLayout,
 ) {
     for p0 in (0..count).step_by(TILE) {
         let p1 = (p0 + TILE).min(count);

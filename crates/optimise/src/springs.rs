@@ -464,15 +464,15 @@ fn levenberg_marquardt(
     solve.evaluate(&y, &mut res);
     let mut lambda = 1e-3;
     let mut slow = 0;
+    // A start creeping along (less than 0.1 % per step for `CREEP_STEPS` steps) is heading for
+    // a solution outside the bounds or at infinity: give it up. A pulled solve only prepares
+    // the start of the unpulled one, so its creep ends it sooner.
+    let creep = if pull.is_some() {
+        PULLED_CREEP_STEPS
+    } else {
+        CREEP_STEPS
+    };
     for _ in 0..300 {
-        // A start creeping along (less than 0.1 % per step for `CREEP_STEPS` steps) is heading
-        // for a solution outside the bounds or at infinity: give it up. A pulled solve only
-        // prepares the start of the unpulled one, so its creep ends it sooner.
-        let creep = if pull.is_some() {
-            PULLED_CREEP_STEPS
-        } else {
-            CREEP_STEPS
-        };
         if slow >= creep {
             break;
         }
