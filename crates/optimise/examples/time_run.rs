@@ -101,14 +101,15 @@ fn main() {
             total,
         ];
         eprintln!(
-            "run {run}: {} ({} passes)",
+            "run {run}: {} ({} passes, {} variants searched)",
             names
                 .iter()
                 .zip(row)
                 .map(|(n, s)| format!("{n} {:.2} s ({:.2} s CPU)", s.wall, s.cpu))
                 .collect::<Vec<_>>()
                 .join(", "),
-            stages.passes
+            stages.passes,
+            stages.searched
         );
         for (col, s) in table.iter_mut().zip(row) {
             col.push(s);

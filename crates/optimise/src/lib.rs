@@ -38,6 +38,7 @@ pub mod slots;
 pub mod springs;
 pub mod timing;
 pub mod torque;
+pub mod twins;
 pub mod verify;
 
 pub use clarabel_map::ConicStatus;

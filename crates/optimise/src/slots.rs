@@ -60,7 +60,7 @@ impl SpringSlot {
     }
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CwPhysical {
     pub mass: f64,
     pub mu: [f64; 3],

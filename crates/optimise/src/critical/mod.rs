@@ -16,6 +16,7 @@ mod finish;
 mod grid;
 mod peaks;
 mod state;
+mod twin_runs;
 
 use std::collections::BTreeSet;
 
@@ -81,12 +82,45 @@ pub fn optimise_all_reporting(
     progress: ProgressSink<'_>,
 ) -> (Vec<OptimisedVariant>, StageTimings) {
     let mut timings = StageTimings::default();
-    let mut runs: Vec<Run> = variants
+    let balanced: Vec<&VariantResult> = variants
         .iter()
         .filter(|v| v.status == Status::Balanced)
+        .collect();
+    let twins = if options.twins {
+        crate::twins::spring_twins(&ctx.basis, &ctx.catalogue, &ctx.bounds)
+    } else {
+        Vec::new()
+    };
+    let leaders = twin_runs::leaders(&balanced, &twins, ctx);
+    let mut leader_runs: Vec<Run> = leaders
+        .variants
+        .iter()
         .map(|v| new_run(ctx, v, options))
         .collect();
-    critical_task_loop(ctx, &mut runs, options, &mut timings, progress);
+    timings.searched = leader_runs.len();
+    critical_task_loop(ctx, &mut leader_runs, options, &mut timings, progress);
+    let runs: Vec<Run> = balanced
+        .iter()
+        .zip(&leaders.of)
+        .map(|(v, &k)| {
+            let leader = &leader_runs[k];
+            let own = leader
+                .elements
+                .iter()
+                .eq(v.elements.iter().map(|e| &e.label));
+            if own {
+                return leader.clone();
+            }
+            let member = new_run(ctx, v, options);
+            twin_runs::follow(ctx, &twins, leader, member).unwrap_or_else(|| {
+                // No counterpart for some slot: search the variant itself.
+                let mut alone = vec![new_run(ctx, v, options)];
+                timings.searched += 1;
+                critical_task_loop(ctx, &mut alone, options, &mut timings, progress);
+                alone.pop().expect("one run")
+            })
+        })
+        .collect();
     let out = finish(ctx, runs, options, &mut timings, progress);
     (out, timings)
 }

@@ -47,6 +47,16 @@ pub struct OptimiseOptions {
     /// two seeds).
     #[serde(default = "default_start_seed")]
     pub start_seed: u64,
+    /// Solve each class of mirror-twin variants once (see [`crate::twins`]): a variant whose
+    /// springs have twins of lower catalogue index takes the certified search of the variant
+    /// holding those twins instead (its verdict, bound and design, anchors mirrored, then its
+    /// own spring choice, evaluation and verification). `false` searches every variant itself.
+    #[serde(default = "default_twins")]
+    pub twins: bool,
+}
+
+pub(super) fn default_twins() -> bool {
+    true
 }
 
 /// How the final all-task evaluation solves the joint reactions of a sample for the batch's
@@ -192,6 +202,7 @@ impl Default for OptimiseOptions {
             solver_iterations: 200,
             max_nodes: crate::certify::DEFAULT_MAX_NODES,
             start_seed: crate::springs::DEFAULT_SEED,
+            twins: default_twins(),
         }
     }
 }
@@ -275,4 +286,7 @@ pub struct StageTimings {
     pub records: StageTime,
     /// Passes of the critical-task loop.
     pub passes: usize,
+    /// Variants the loop searched: one per class of mirror twins (see [`crate::twins`]), with
+    /// any leader that is not among the variants.
+    pub searched: usize,
 }

@@ -1229,3 +1229,83 @@ fn the_spring_normal_equations_are_those_of_the_central_difference_jacobian() {
     }
     assert!(active_hinges > 0, "the point leaves every bound inactive");
 }
+
+/// The palletizer's mirror twins K42 and K53 (see `crate::twins`): m4 + K53 takes the certified
+/// search of m4 + K42 with both anchors negated, keeps its own verification, and is the same
+/// whether or not m4 + K42 is among the variants (a shard holding only the follower solves the
+/// leader itself); searched alone, it reaches the same verdict and an objective within the gap.
+#[test]
+fn a_mirror_twin_takes_its_leaders_search_with_the_anchors_negated() {
+    let model = model(&case_json("palletizer.json"));
+    let ctx = Context::new(&model, None).unwrap();
+    let leader = balanced_variant(&model, &["m4", "K42"]);
+    let follower = balanced_variant(&model, &["m4", "K53"]);
+    let options = OptimiseOptions::default();
+    let both = optimise_all(&ctx, &[leader.clone(), follower.clone()], &options);
+    let (l, f) = (&both[0], &both[1]);
+    assert_eq!(l.status, Status::Feasible);
+    assert_eq!(f.status, Status::Feasible);
+    // After the loop, the follower's candidate is the leader's with the spring's anchors (and
+    // its lifted K·a, K·b) negated and K·a·b kept.
+    let twins = crate::twins::spring_twins(&ctx.basis, &ctx.catalogue, &ctx.bounds);
+    let leader_run = run_after_loop(&ctx, &leader, &options);
+    let followed = super::twin_runs::follow(
+        &ctx,
+        &twins,
+        &leader_run,
+        new_run(&ctx, &follower, &options),
+    )
+    .expect("every slot has a counterpart");
+    let (lc, fc) = (
+        leader_run.candidate.as_ref().unwrap(),
+        followed.candidate.as_ref().unwrap(),
+    );
+    let (ls, fs) = (&lc.springs[0], &fc.springs[0]);
+    assert_eq!((ls.label.as_str(), fs.label.as_str()), ("K42", "K53"));
+    assert_eq!(fs.body, "front_link");
+    assert_eq!(fs.stiffness, ls.stiffness);
+    assert_eq!(fs.anchor_a, ls.anchor_a.map(|v| -v));
+    assert_eq!(fs.anchor_b, ls.anchor_b.map(|v| -v));
+    let (lp, fp) = (
+        leader_run.problem.as_ref().unwrap(),
+        followed.problem.as_ref().unwrap(),
+    );
+    let (lk, fk) = (lp.springs[0].column, fp.springs[0].column);
+    // K, K·ax, K·ay, K·bx, K·by, then the four K·a·b.
+    let signs = [1.0, -1.0, -1.0, -1.0, -1.0, 1.0, 1.0, 1.0, 1.0];
+    for (k, s) in signs.iter().enumerate() {
+        assert_eq!(fc.x[fk + k], s * lc.x[lk + k]);
+    }
+    assert_eq!(fc.cws, lc.cws);
+    assert_eq!(fc.lower_bound, lc.lower_bound);
+    assert_eq!(followed.working, leader_run.working);
+    // The follower keeps its own spring choice (the springs load other joints), on the
+    // leader's counterweight.
+    assert_eq!(f.counterweights, l.counterweights);
+    // The same certified bound; the objective is its own evaluation's, equal to rounding (the
+    // springs never change the motor torques); its own balance check passes.
+    assert_eq!(f.lower_bound, l.lower_bound);
+    let (lo, fo) = (l.objective.unwrap(), f.objective.unwrap());
+    assert!((lo - fo).abs() <= 1e-9 * lo, "{lo} against {fo}");
+    assert!(f.residual.unwrap() < 1e-9, "residual {:?}", f.residual);
+    // Alone, the follower is solved through its leader: the same bits.
+    let alone = optimise_all(&ctx, std::slice::from_ref(&follower), &options);
+    assert_eq!(alone[0].springs, f.springs);
+    assert_eq!(alone[0].counterweights, f.counterweights);
+    assert_eq!(alone[0].objective, f.objective);
+    // Searched itself: the same verdict, an objective within the gap tolerance of the twin's.
+    let itself = optimise_all(
+        &ctx,
+        std::slice::from_ref(&follower),
+        &OptimiseOptions {
+            twins: false,
+            ..options
+        },
+    );
+    assert_eq!(itself[0].status, Status::Feasible);
+    let io = itself[0].objective.unwrap();
+    assert!(
+        (io - fo).abs() <= options.gap_tolerance * io,
+        "{io} against {fo}"
+    );
+}
