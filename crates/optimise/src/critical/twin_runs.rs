@@ -39,7 +39,8 @@ pub(super) fn leaders(
     let mut of = Vec::with_capacity(balanced.len());
     for v in balanced {
         let leader = leader_variant(v, twins, ctx);
-        let key: Vec<usize> = leader.elements.iter().map(|e| e.entry).collect();
+        let mut key: Vec<usize> = leader.elements.iter().map(|e| e.entry).collect();
+        key.sort_unstable();
         let k = *index.entry(key).or_insert_with(|| {
             variants.push(leader);
             variants.len() - 1
@@ -70,12 +71,10 @@ fn leader_variant(v: &VariantResult, twins: &[Option<SpringTwin>], ctx: &Context
         .collect();
     elements.sort_by_key(|e| e.entry);
     let repeated = elements.windows(2).any(|w| w[0].entry == w[1].entry);
-    if repeated
-        || elements
-            .iter()
-            .map(|e| e.entry)
-            .eq(v.elements.iter().map(|e| e.entry))
-    {
+    let mut own: Vec<usize> = v.elements.iter().map(|e| e.entry).collect();
+    own.sort_unstable();
+    if repeated || elements.iter().map(|e| e.entry).eq(own) {
+        // No spring follows a twin (whatever the order `v` lists its elements in).
         return v.clone();
     }
     VariantResult {
