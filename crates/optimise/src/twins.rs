@@ -321,4 +321,97 @@ mod tests {
         ctx.bounds.entries[k53] = ElementBounds::Spring(narrowed);
         assert!(spring_twins(&ctx.basis, &ctx.catalogue, &ctx.bounds)[k53].is_none());
     }
+
+    /// Two planar springs to the base with hand-made columns: `[j + 1, 2j + 3]` for lifted
+    /// variable `j` (`K`, `K·ax`, `K·ay`, `K·bx`, `K·by`, `K·ax·bx`, `K·ax·by`, `K·ay·bx`,
+    /// `K·ay·by`), the follower's with the signs given and its `axes_b`.
+    fn pair(
+        signs: [i64; 9],
+        axes_b: Vec<usize>,
+        boxes: ([f64; 2], [f64; 2]),
+    ) -> Option<SpringTwin> {
+        use counterpoise_balance::{Attachment, CatalogueEntry};
+        use counterpoise_symbolic::Rational;
+        let spring = |label: &str, axes_b: Vec<usize>| CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: vec![0, 1],
+                axes_b,
+            },
+            label: label.into(),
+            description: String::new(),
+            bodies: Vec::new(),
+            variables: Vec::new(),
+            energy: Vec::new(),
+        };
+        let catalogue = Catalogue {
+            entries: vec![spring("K10", vec![0, 1]), spring("K20", axes_b)],
+        };
+        let bounds = |box_ax: [f64; 2]| {
+            let mut box_a = [crate::overrides::FREE_AXIS; 3];
+            box_a[0] = box_ax;
+            ElementBounds::Spring(SpringBounds {
+                stiffness: [1000.0, 10000.0],
+                anchor_a: [0.0, 1.0],
+                anchor_b: [0.0, 0.5],
+                box_a,
+                box_b: [crate::overrides::FREE_AXIS; 3],
+            })
+        };
+        let table = BoundsTable {
+            entries: vec![bounds(boxes.0), bounds(boxes.1)],
+        };
+        let int = |k: i64| Rational::from_integer(k.into()).numer().clone();
+        let leader: Vec<Vec<_>> = (0..9).map(|j| vec![int(j + 1), int(2 * j + 3)]).collect();
+        let follower: Vec<Vec<_>> = (0..9)
+            .map(|j| {
+                vec![
+                    int(signs[j as usize] * (j + 1)),
+                    int(signs[j as usize] * (2 * j + 3)),
+                ]
+            })
+            .collect();
+        twin_of::<Rational>(&catalogue, &table, &leader, &follower, 0, 1)
+    }
+
+    const FREE: [f64; 2] = crate::overrides::FREE_AXIS;
+
+    /// The sign pattern is read off the columns: `K·ax` and the two products holding `ax`
+    /// negated make `a_x` the mirrored coordinate; a column negated alone matches no pattern
+    /// (`K·ax` flips but `K·ax·bx` does not); springs on other anchor axes are never twins;
+    /// a box on a mirrored axis must be the leader's reflected.
+    #[test]
+    fn a_twin_is_found_by_its_sign_pattern() {
+        let same = pair([1; 9], vec![0, 1], (FREE, FREE)).expect("identical columns");
+        assert_eq!(
+            (same.leader, same.sign_a, same.sign_b),
+            (0, vec![1.0, 1.0], vec![1.0, 1.0])
+        );
+        let ax = [1, -1, 1, 1, 1, -1, -1, 1, 1];
+        let mirrored = pair(ax, vec![0, 1], (FREE, FREE)).expect("a_x mirrored");
+        assert_eq!(
+            (mirrored.sign_a.clone(), mirrored.sign_b.clone()),
+            (vec![-1.0, 1.0], vec![1.0, 1.0])
+        );
+        assert_eq!(mirrored.lifted_signs(), ax.map(|s| s as f64));
+        let by = [1, 1, 1, 1, -1, 1, -1, 1, -1];
+        let mirrored = pair(by, vec![0, 1], (FREE, FREE)).expect("b_y mirrored");
+        assert_eq!(
+            (mirrored.sign_a, mirrored.sign_b),
+            (vec![1.0, 1.0], vec![1.0, -1.0])
+        );
+        assert!(pair([1, -1, 1, 1, 1, 1, 1, 1, 1], vec![0, 1], (FREE, FREE)).is_none());
+        assert!(
+            pair([-1; 9], vec![0, 1], (FREE, FREE)).is_none(),
+            "K never flips"
+        );
+        assert!(
+            pair([1; 9], vec![0, 2], (FREE, FREE)).is_none(),
+            "b on x and z"
+        );
+        assert!(pair(ax, vec![0, 1], ([-0.5, 0.2], [-0.2, 0.5])).is_some());
+        assert!(pair(ax, vec![0, 1], ([-0.5, 0.2], [-0.5, 0.2])).is_none());
+        assert!(pair([1; 9], vec![0, 1], ([-0.5, 0.2], [-0.5, 0.2])).is_some());
+    }
 }
