@@ -377,6 +377,67 @@ mod tests {
 
     const FREE: [f64; 2] = crate::overrides::FREE_AXIS;
 
+    /// [`pair`] for springs on `axes` (both anchors), free boxes, with the follower's columns
+    /// the leader's times the lifted signs of `sign_a`, `sign_b`.
+    fn pair_on(axes: Vec<usize>, sign_a: Vec<f64>, sign_b: Vec<f64>) -> Option<SpringTwin> {
+        use counterpoise_balance::{Attachment, CatalogueEntry};
+        use counterpoise_symbolic::Rational;
+        let spring = || CatalogueEntry {
+            element: Element::Spring {
+                body: 0,
+                other: Attachment::Base,
+                axes_a: axes.clone(),
+                axes_b: axes.clone(),
+            },
+            label: String::new(),
+            description: String::new(),
+            bodies: Vec::new(),
+            variables: Vec::new(),
+            energy: Vec::new(),
+        };
+        let catalogue = Catalogue {
+            entries: vec![spring(), spring()],
+        };
+        let free = ElementBounds::Spring(SpringBounds {
+            stiffness: [1000.0, 10000.0],
+            anchor_a: [0.0, 1.0],
+            anchor_b: [0.0, 0.5],
+            box_a: [FREE; 3],
+            box_b: [FREE; 3],
+        });
+        let table = BoundsTable {
+            entries: vec![free, free],
+        };
+        let signs = SpringTwin {
+            leader: 0,
+            sign_a,
+            sign_b,
+        }
+        .lifted_signs();
+        let int = |k: i64| Rational::from_integer(k.into()).numer().clone();
+        let leader: Vec<Vec<_>> = (0..signs.len() as i64).map(|j| vec![int(j + 1)]).collect();
+        let follower: Vec<Vec<_>> = signs
+            .iter()
+            .zip(0..)
+            .map(|(&s, j)| vec![int(s as i64 * (j + 1))])
+            .collect();
+        twin_of::<Rational>(&catalogue, &table, &leader, &follower, 0, 1)
+    }
+
+    /// Springs on one axis and on three: every sign pattern of `a` and `b` is tried, `b`'s
+    /// signs read from the bits after `a`'s.
+    #[test]
+    fn every_sign_pattern_is_tried_on_one_and_three_axes() {
+        let one = pair_on(vec![0], vec![1.0], vec![-1.0]).expect("b mirrored on one axis");
+        assert_eq!((one.sign_a, one.sign_b), (vec![1.0], vec![-1.0]));
+        let three = pair_on(vec![0, 1, 2], vec![-1.0, 1.0, 1.0], vec![1.0, 1.0, -1.0])
+            .expect("a_x and b_z mirrored");
+        assert_eq!(
+            (three.sign_a, three.sign_b),
+            (vec![-1.0, 1.0, 1.0], vec![1.0, 1.0, -1.0])
+        );
+    }
+
     /// The sign pattern is read off the columns: `K·ax` and the two products holding `ax`
     /// negated make `a_x` the mirrored coordinate; a column negated alone matches no pattern
     /// (`K·ax` flips but `K·ax·bx` does not); springs on other anchor axes are never twins;
