@@ -1309,3 +1309,28 @@ fn a_mirror_twin_takes_its_leaders_search_with_the_anchors_negated() {
         "{io} against {fo}"
     );
 }
+
+/// Leaders: m4 + K53 and m4 + K42 share m4 + K42; K42 + K53 would need K42 twice and is its
+/// own leader; the order the variants come in does not change a leader.
+#[test]
+fn each_variant_follows_the_variant_of_its_springs_twins() {
+    let model = model(&case_json("palletizer.json"));
+    let ctx = Context::new(&model, None).unwrap();
+    let twins = crate::twins::spring_twins(&ctx.basis, &ctx.catalogue, &ctx.bounds);
+    let both = balanced_variant(&model, &["K42", "K53"]);
+    let m4_k53 = balanced_variant(&model, &["m4", "K53"]);
+    let m4_k42 = balanced_variant(&model, &["m4", "K42"]);
+    let labels =
+        |v: &VariantResult| -> Vec<String> { v.elements.iter().map(|e| e.label.clone()).collect() };
+    for order in [vec![&both, &m4_k53, &m4_k42], vec![&m4_k42, &both, &m4_k53]] {
+        let leaders = super::twin_runs::leaders(&order, &twins, &ctx);
+        assert_eq!(leaders.variants.len(), 2);
+        let leader_of = |v: &VariantResult| {
+            let k = order.iter().position(|w| std::ptr::eq(*w, v)).unwrap();
+            labels(&leaders.variants[leaders.of[k]])
+        };
+        assert_eq!(leader_of(&both), ["K42", "K53"]);
+        assert_eq!(leader_of(&m4_k53), ["m4", "K42"]);
+        assert_eq!(leader_of(&m4_k42), ["m4", "K42"]);
+    }
+}
