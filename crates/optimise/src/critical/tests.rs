@@ -1334,3 +1334,27 @@ fn each_variant_follows_the_variant_of_its_springs_twins() {
         assert_eq!(leader_of(&m4_k42), ["m4", "K42"]);
     }
 }
+
+/// A discard carries over with its proof: m5 + K53 is discarded as m5 + K42 is, by the same
+/// bound, and says whose proof it is.
+#[test]
+fn a_twin_of_a_discarded_variant_is_discarded_by_the_same_proof() {
+    let model = model(&case_json("palletizer.json"));
+    let ctx = Context::new(&model, None).unwrap();
+    let leader = balanced_variant(&model, &["m5", "K42"]);
+    let follower = balanced_variant(&model, &["m5", "K53"]);
+    let out = optimise_all(&ctx, &[leader, follower], &OptimiseOptions::default());
+    assert_eq!(out[0].status, Status::Discarded);
+    assert_eq!(out[1].status, Status::Discarded);
+    let reason = out[0].reason.clone().unwrap();
+    assert!(
+        reason.contains("m5 would need a mass of at least"),
+        "{reason}"
+    );
+    assert_eq!(
+        out[1].reason.clone().unwrap(),
+        format!(
+            "as for m5 + K42, whose springs store the same energy with mirrored anchors: {reason}"
+        )
+    );
+}
