@@ -1263,6 +1263,7 @@ fn a_mirror_twin_takes_its_leaders_search_with_the_anchors_negated() {
     let (ls, fs) = (&lc.springs[0], &fc.springs[0]);
     assert_eq!((ls.label.as_str(), fs.label.as_str()), ("K42", "K53"));
     assert_eq!(fs.body, "front_link");
+    assert_eq!(fs.other, "slider_v");
     assert_eq!(fs.stiffness, ls.stiffness);
     assert_eq!(fs.anchor_a, ls.anchor_a.map(|v| -v));
     assert_eq!(fs.anchor_b, ls.anchor_b.map(|v| -v));
