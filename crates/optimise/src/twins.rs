@@ -40,6 +40,16 @@ pub struct SpringTwin {
 }
 
 impl SpringTwin {
+    /// A spring as its own twin: every sign `+1` (a spring that follows none keeps its
+    /// anchors when a variant is mirrored).
+    pub fn identity(spring: usize, na: usize, nb: usize) -> SpringTwin {
+        SpringTwin {
+            leader: spring,
+            sign_a: vec![1.0; na],
+            sign_b: vec![1.0; nb],
+        }
+    }
+
     /// The sign of each lifted variable of the spring (`K`, `K·a_i`, `K·b_l`, `K·a_i·b_l`):
     /// the follower's lifted value is the sign times the leader's.
     pub fn lifted_signs(&self) -> Vec<f64> {
@@ -444,6 +454,7 @@ mod tests {
     /// a box on a mirrored axis must be the leader's reflected.
     #[test]
     fn a_twin_is_found_by_its_sign_pattern() {
+        assert_eq!(SpringTwin::identity(3, 2, 2).lifted_signs(), [1.0; 9]);
         let same = pair([1; 9], vec![0, 1], (FREE, FREE)).expect("identical columns");
         assert_eq!(
             (same.leader, same.sign_a, same.sign_b),

@@ -138,22 +138,17 @@ fn mirror_candidate(
     }
     let mut springs = Vec::with_capacity(mp.springs.len());
     for slot in &mp.springs {
-        let twin = twins.get(slot.entry).and_then(Option::as_ref);
-        let leader_entry = twin.map_or(slot.entry, |t| t.leader);
-        let from = lp.springs.iter().find(|l| l.entry == leader_entry)?;
+        let mirror = twins
+            .get(slot.entry)
+            .and_then(Option::clone)
+            .unwrap_or_else(|| {
+                SpringTwin::identity(slot.entry, slot.axes_a.len(), slot.axes_b.len())
+            });
+        let from = lp.springs.iter().find(|l| l.entry == mirror.leader)?;
         if from.axes_a != slot.axes_a || from.axes_b != slot.axes_b {
             return None;
         }
-        let (sign_a, sign_b) = match twin {
-            Some(t) => (t.sign_a.clone(), t.sign_b.clone()),
-            None => (vec![1.0; slot.axes_a.len()], vec![1.0; slot.axes_b.len()]),
-        };
-        let signs = SpringTwin {
-            leader: leader_entry,
-            sign_a: sign_a.clone(),
-            sign_b: sign_b.clone(),
-        }
-        .lifted_signs();
+        let signs = mirror.lifted_signs();
         for (k, s) in signs.iter().enumerate() {
             x[slot.column + k] = s * cand.x[from.column + k];
         }
@@ -161,10 +156,10 @@ fn mirror_candidate(
         let mut anchor_a = spring.anchor_a;
         let mut anchor_b = spring.anchor_b;
         for (i, &axis) in slot.axes_a.iter().enumerate() {
-            anchor_a[axis] = sign_a[i] * spring.anchor_a[axis];
+            anchor_a[axis] = mirror.sign_a[i] * spring.anchor_a[axis];
         }
         for (l, &axis) in slot.axes_b.iter().enumerate() {
-            anchor_b[axis] = sign_b[l] * spring.anchor_b[axis];
+            anchor_b[axis] = mirror.sign_b[l] * spring.anchor_b[axis];
         }
         let entry = &ctx.catalogue.entries[slot.entry];
         springs.push(crate::springs::Spring {
