@@ -481,6 +481,46 @@ fn a_hybrid_whose_boxes_propose_poor_designs_is_descended_to_a_better_one() {
     assert!(v.verification.as_ref().unwrap().passed);
 }
 
+/// m4 + K42 + K65 at Dmax 3, the heaviest search of the study without the split history
+/// (1,735 boxes): near the optimum the coupling error stays large on K65's anchor components,
+/// whose splits raise no bound, while K42's `b_y` splits close most of their children (410
+/// boxes with the history). Weighted by what its splits did, the search must close the same
+/// gap in at most half the boxes, each
+/// design within the gap tolerance of the other search's certified bound, both verified.
+#[test]
+fn the_split_history_halves_the_heaviest_search() {
+    let model = palletizer_dmax3();
+    let labels: &[&str] = &["m4", "K42", "K65"];
+    let run = |split_history: bool| {
+        let options = OptimiseOptions {
+            split_history,
+            ..OptimiseOptions::default()
+        };
+        let (_, mut results) = common::optimise(&model, &[labels], &options);
+        let v = results.pop().unwrap();
+        assert_eq!(v.status, Status::Feasible, "{:?}", v.reason);
+        assert!(v.residual.unwrap() <= 1e-9);
+        assert!(v.gap.unwrap() <= 1e-3, "gap {:?}", v.gap);
+        let boxes: usize = v.iterations.iter().map(|i| i.boxes).sum();
+        (v.objective.unwrap(), v.lower_bound.unwrap(), boxes)
+    };
+    let (with, without) = (run(true), run(false));
+    assert!(
+        with.0 - without.1 <= 1e-3 * with.0,
+        "{with:?} against {without:?}"
+    );
+    assert!(
+        without.0 - with.1 <= 1e-3 * without.0,
+        "{without:?} against {with:?}"
+    );
+    assert!(
+        2 * with.2 <= without.2,
+        "{} boxes with the history against {} without",
+        with.2,
+        without.2
+    );
+}
+
 /// The palletizer case at Dmax 3.
 fn palletizer_dmax3() -> counterpoise_model::Model {
     let mut json = common::case_json("palletizer.json");

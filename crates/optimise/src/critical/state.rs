@@ -53,6 +53,15 @@ pub struct OptimiseOptions {
     /// own spring choice, evaluation and verification). `false` searches every variant itself.
     #[serde(default = "default_twins")]
     pub twins: bool,
+    /// Weight each spring coordinate's choice for a split by what its earlier splits did to the
+    /// bounds ([`crate::certify::BranchOptions::split_history`]). `false` keeps the coupling
+    /// error alone (to compare).
+    #[serde(default = "default_split_history")]
+    pub split_history: bool,
+}
+
+pub(super) fn default_split_history() -> bool {
+    true
 }
 
 pub(super) fn default_twins() -> bool {
@@ -185,6 +194,7 @@ impl OptimiseOptions {
             gap_tolerance: self.gap_tolerance,
             max_nodes: self.max_nodes,
             solver_iterations: self.solver_iterations,
+            split_history: self.split_history,
         }
     }
 }
@@ -203,6 +213,7 @@ impl Default for OptimiseOptions {
             max_nodes: crate::certify::DEFAULT_MAX_NODES,
             start_seed: crate::springs::DEFAULT_SEED,
             twins: default_twins(),
+            split_history: default_split_history(),
         }
     }
 }

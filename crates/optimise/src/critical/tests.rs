@@ -457,6 +457,51 @@ fn a_search_resumed_on_more_tasks_ends_where_a_fresh_one_does() {
     );
 }
 
+/// The split history only orders the splits: the pendulum hybrid searched with and without it
+/// ends optimal both ways, each design within the gap tolerance of the other search's certified
+/// bound (two searches of one problem, each a proof about the other's answer), and the history
+/// changes the search's path (it is in use: the boxes differ).
+#[test]
+fn the_split_history_changes_the_path_not_the_certified_answer() {
+    let (_, ctx, variant) = pendulum_m1_k10(5.0, true);
+    let options = OptimiseOptions::default();
+    let run = new_run(&ctx, &variant, &options);
+    let problem = run.problem.as_ref().unwrap();
+    let tasks: Vec<usize> = (0..ctx.tasks.len().min(6)).collect();
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &tasks);
+    let b = &ctx.basis.unbalanced;
+    let search = |split_history: bool| {
+        let branch = BranchOptions {
+            max_nodes: 2000,
+            split_history,
+            ..options.branch_options()
+        };
+        match branch_and_bound(problem, b, &tasks, options.objective, &branch, None, None)
+            .unwrap()
+            .0
+        {
+            Verdict::Optimal {
+                design,
+                lower_bound,
+                nodes,
+            } => (design.value, lower_bound, nodes),
+            other => panic!("the search must end optimal: {other:?}"),
+        }
+    };
+    let (with, without) = (search(true), search(false));
+    let tol = options.gap_tolerance;
+    assert!(
+        with.0 - without.1 <= tol * with.0,
+        "{with:?} against {without:?}"
+    );
+    assert!(
+        without.0 - with.1 <= tol * without.0,
+        "{without:?} against {with:?}"
+    );
+    assert!(with.1 <= with.0 && without.1 <= without.0);
+    assert_ne!(with.2, without.2, "the history must change the path");
+}
+
 /// The children of a split are solved in parallel (`certify::bound_boxes`), each from the peak
 /// rows known before the split: the search must end with the same bits in a pool of one thread
 /// and of two (the pendulum hybrid splits both its anchors and its counterweight over
