@@ -43,7 +43,7 @@ pub struct OptimiseOptions {
     /// Seed of the local search's starting points after the first. Verdicts do not depend on
     /// it, nor an objective beyond its certified gap; ranks can move where a gap stays open or
     /// another design within the gap gives the spring choice by ΔR (a local search, not
-    /// certified) other options (at Dmax 3 on the palletizer, 60 of 788 rank numbers between
+    /// certified) other options (at Dmax 3 on the palletizer, 96 of 788 rank numbers between
     /// two seeds).
     #[serde(default = "default_start_seed")]
     pub start_seed: u64,
