@@ -19,8 +19,8 @@
 //!   their relative widths; only the part of it that the family cannot remove by moving `W`
 //!   alone, module `coupling`) weighted by how much that coordinate's earlier splits raised
 //!   the bounds (module `split_history`), or, when the springs' error is negligible, of the
-//!   widest counterweight coordinate (springs first while no design is known, or where the relaxed
-//!   point promised a better design but none was realized); midpoint splits shrink every
+//!   widest counterweight coordinate (springs first while no design is known, or where the
+//!   relaxed point promised a better design but none was realized); midpoint splits shrink every
 //!   box, so the relaxation converges to the true problem and the search terminates;
 //! - **stops** when the best design is within the gap tolerance of the smallest open bound
 //!   (certified optimum), when no box is left (proved impossible), or at the node budget

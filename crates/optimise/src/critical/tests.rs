@@ -463,12 +463,7 @@ fn a_search_resumed_on_more_tasks_ends_where_a_fresh_one_does() {
 /// changes the search's path (it is in use: the boxes differ).
 #[test]
 fn the_split_history_changes_the_path_not_the_certified_answer() {
-    let (_, ctx, variant) = pendulum_m1_k10(5.0, true);
-    let options = OptimiseOptions::default();
-    let run = new_run(&ctx, &variant, &options);
-    let problem = run.problem.as_ref().unwrap();
-    let tasks: Vec<usize> = (0..ctx.tasks.len().min(6)).collect();
-    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &tasks);
+    let (ctx, problem, tasks, options) = pendulum_hybrid_search();
     let b = &ctx.basis.unbalanced;
     let search = |split_history: bool| {
         let branch = BranchOptions {
@@ -476,7 +471,7 @@ fn the_split_history_changes_the_path_not_the_certified_answer() {
             split_history,
             ..options.branch_options()
         };
-        match branch_and_bound(problem, b, &tasks, options.objective, &branch, None, None)
+        match branch_and_bound(&problem, b, &tasks, options.objective, &branch, None, None)
             .unwrap()
             .0
         {
@@ -502,18 +497,29 @@ fn the_split_history_changes_the_path_not_the_certified_answer() {
     assert_ne!(with.2, without.2, "the history must change the path");
 }
 
+/// The pendulum hybrid (m1 + K10, a counterweight of up to 5 kg) ready for a search on its
+/// first six tasks, with the default options.
+fn pendulum_hybrid_search() -> (
+    Context,
+    VariantProblem,
+    Vec<Arc<TaskTorques>>,
+    OptimiseOptions,
+) {
+    let (_, ctx, variant) = pendulum_m1_k10(5.0, true);
+    let options = OptimiseOptions::default();
+    let problem = new_run(&ctx, &variant, &options).problem.unwrap();
+    let tasks: Vec<usize> = (0..ctx.tasks.len().min(6)).collect();
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &tasks);
+    (ctx, problem, tasks, options)
+}
+
 /// The children of a split are solved in parallel (`certify::bound_boxes`), each from the peak
 /// rows known before the split: the search must end with the same bits in a pool of one thread
 /// and of two (the pendulum hybrid splits both its anchors and its counterweight over
 /// hundreds of boxes).
 #[test]
 fn a_search_gives_the_same_bits_on_one_thread_and_on_two() {
-    let (_, ctx, variant) = pendulum_m1_k10(5.0, true);
-    let options = OptimiseOptions::default();
-    let run = new_run(&ctx, &variant, &options);
-    let problem = run.problem.as_ref().unwrap();
-    let tasks: Vec<usize> = (0..ctx.tasks.len().min(6)).collect();
-    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &tasks);
+    let (ctx, problem, tasks, options) = pendulum_hybrid_search();
     let branch = BranchOptions {
         max_nodes: 2000,
         ..options.branch_options()
@@ -525,7 +531,7 @@ fn a_search_gives_the_same_bits_on_one_thread_and_on_two() {
             .build()
             .unwrap();
         pool.install(|| {
-            branch_and_bound(problem, b, &tasks, options.objective, &branch, None, None).unwrap()
+            branch_and_bound(&problem, b, &tasks, options.objective, &branch, None, None).unwrap()
         })
     };
     let outcome = |v: Verdict| match v {
