@@ -862,13 +862,12 @@ pub fn branch_and_bound(
         nodes += boxes.len();
         let children = bound_boxes(problem, &bases, &mut active, options, boxes, current.bound);
         if let Some(d) = best.as_ref().filter(|_| options.split_history) {
-            let need = d.value - options.gap_tolerance * d.value.abs();
             let bound = |c: &Option<Open>| c.as_ref().map(|o| o.bound);
             history.record(
                 k,
                 current.bound,
-                need,
-                options.gap_tolerance * d.value.abs(),
+                d.value,
+                options.gap_tolerance,
                 [bound(&children[0]), bound(&children[1])],
             );
         }

@@ -78,18 +78,21 @@ impl SplitHistory {
         }
     }
 
-    /// Scores a split of coordinate `k` of a box whose bound `parent` lacked `need` to close;
-    /// `children` are the halves' bounds (`None`: empty); `slack` is the gap the tolerance
-    /// allows. A split of a box that needed nothing (`need ≤ parent`) tells nothing and is not
-    /// scored.
+    /// Scores a split of coordinate `k` of a box whose bound was `parent`, made while the best
+    /// design's value was `best`: a box closes once its bound comes within the gap tolerance
+    /// `tolerance` of `best` (the search's own test), so it lacked `need − parent` with
+    /// `need = best − slack`, `slack = tolerance·|best|`. `children` are the halves' bounds
+    /// (`None`: empty). A split of a box that needed nothing tells nothing and is not scored.
     pub(crate) fn record(
         &mut self,
         k: usize,
         parent: f64,
-        need: f64,
-        slack: f64,
+        best: f64,
+        tolerance: f64,
         children: [Option<f64>; 2],
     ) {
+        let slack = tolerance * best.abs();
+        let need = best - slack;
         if need.is_nan() || parent.is_nan() || need <= parent {
             return;
         }
@@ -126,30 +129,48 @@ mod tests {
 
     #[test]
     fn a_coordinate_whose_splits_close_nothing_loses_its_weight() {
+        // best design 16 at a tolerance of 1/8: a box closes at 16 − 2 = 14; from a bound of 10
+        // it lacks 4, within 5 × 2 of closing, so every split below counts fully
+        let (best, tol) = (16.0, 0.125);
         let mut h = SplitHistory::new(3);
         // never split: fully effective
         assert_eq!(h.effect(0), 1.0);
-        // coordinate 0: both children closed (one empty) — gain 1
-        h.record(0, 10.0, 12.0, 1.0, [None, Some(12.5)]);
+        // coordinate 0: both children closed (one empty, one at 14.5) — gain 1
+        h.record(0, 10.0, best, tol, [None, Some(14.5)]);
         assert_eq!(h.effect(0), 1.0);
-        // coordinate 1: children at 11 and 10.5 — gain (0.5 + 0.25)/2 = 0.375
-        h.record(1, 10.0, 12.0, 1.0, [Some(11.0), Some(10.5)]);
+        // coordinate 1: children at 12 and 11 made up 2/4 and 1/4 — gain 0.375
+        h.record(1, 10.0, best, tol, [Some(12.0), Some(11.0)]);
         let expected = (PRIOR_SPLITS + 0.375) / (PRIOR_SPLITS + 1.0);
         assert!((h.effect(1) - expected).abs() < 1e-15, "{}", h.effect(1));
         // coordinate 2: four splits that raised nothing — down to the prior's share, then
         // held at the floor
         for _ in 0..4 {
-            h.record(2, 10.0, 12.0, 1.0, [Some(10.0), Some(10.0)]);
+            h.record(2, 10.0, best, tol, [Some(10.0), Some(10.0)]);
         }
         let expected = PRIOR_SPLITS / (PRIOR_SPLITS + 4.0);
         assert!(expected > EFFECT_FLOOR);
         assert!((h.effect(2) - expected).abs() < 1e-15, "{}", h.effect(2));
         for _ in 0..1000 {
-            h.record(2, 10.0, 12.0, 1.0, [Some(10.0), Some(10.0)]);
+            h.record(2, 10.0, best, tol, [Some(10.0), Some(10.0)]);
         }
         assert_eq!(h.effect(2), EFFECT_FLOOR);
         // the others are untouched
         assert_eq!(h.effect(0), 1.0);
+    }
+
+    #[test]
+    fn the_shortfall_is_to_the_best_design_less_the_tolerance() {
+        // a negative objective: best −16 at 1/8 closes at −16 − 2 = −18; from −20 a child at −19
+        // made up half
+        let mut h = SplitHistory::new(1);
+        h.record(0, -20.0, -16.0, 0.125, [Some(-19.0), Some(-19.0)]);
+        let expected = (PRIOR_SPLITS + 0.5) / (PRIOR_SPLITS + 1.0);
+        assert!((h.effect(0) - expected).abs() < 1e-15, "{}", h.effect(0));
+        // a child at 13 made up 3 of the 4 a bound of 10 lacked to reach 14 (best 16, 1/8)
+        let mut h = SplitHistory::new(1);
+        h.record(0, 10.0, 16.0, 0.125, [Some(13.0), Some(13.0)]);
+        let expected = (PRIOR_SPLITS + 0.75) / (PRIOR_SPLITS + 1.0);
+        assert!((h.effect(0) - expected).abs() < 1e-15, "{}", h.effect(0));
     }
 
     #[test]
@@ -159,26 +180,29 @@ mod tests {
         assert_eq!(evidence_weight(10.0, 10.5, 0.2), 1.0);
         assert_eq!(evidence_weight(10.0, 12.0, 0.2), 0.5);
         assert_eq!(evidence_weight(10.0, 14.0, 0.2), 0.25);
-        // no slack (a gap tolerance of 0): nothing is learnt, the rule stays the error's
-        assert_eq!(evidence_weight(10.0, 12.0, 0.0), 0.0);
+        // best 16 at 1/64: slack 0.25, the box closes at 15.75; from 10.75 it lacks 5 = 20
+        // slacks, so a split counts a quarter
         let mut h = SplitHistory::new(2);
-        h.record(0, 10.0, 14.0, 0.2, [Some(10.0), Some(10.0)]);
+        h.record(0, 10.75, 16.0, 1.0 / 64.0, [Some(10.75), Some(10.75)]);
         let expected = PRIOR_SPLITS / (PRIOR_SPLITS + 0.25);
         assert!((h.effect(0) - expected).abs() < 1e-15, "{}", h.effect(0));
-        h.record(1, 10.0, 12.0, 0.0, [Some(10.0), Some(10.0)]);
-        assert_eq!(h.effect(1), 1.0);
-        // a closing split far from the need counts as little, towards 1
-        h.record(0, 10.0, 14.0, 0.2, [None, None]);
+        // a closing split as far counts as little, towards 1
+        h.record(0, 10.75, 16.0, 1.0 / 64.0, [None, None]);
         let expected = (PRIOR_SPLITS + 0.25) / (PRIOR_SPLITS + 0.5);
         assert!((h.effect(0) - expected).abs() < 1e-15, "{}", h.effect(0));
+        // no slack (a gap tolerance of 0): nothing is learnt, the rule stays the error's
+        h.record(1, 10.0, 16.0, 0.0, [Some(10.0), Some(10.0)]);
+        assert_eq!(h.effect(1), 1.0);
     }
 
     #[test]
     fn a_split_of_a_box_that_needed_nothing_is_not_scored() {
         let mut h = SplitHistory::new(1);
-        h.record(0, 12.0, 12.0, 1.0, [Some(12.0), Some(12.0)]);
-        h.record(0, 13.0, 12.0, 1.0, [Some(13.0), Some(13.0)]);
-        h.record(0, 10.0, f64::NAN, 1.0, [Some(10.0), Some(10.0)]);
+        // best 16 at 1/8 closes at 14: bounds of 14 and 15 needed nothing
+        h.record(0, 14.0, 16.0, 0.125, [Some(14.0), Some(14.0)]);
+        h.record(0, 15.0, 16.0, 0.125, [Some(15.0), Some(15.0)]);
+        h.record(0, 10.0, f64::NAN, 0.125, [Some(10.0), Some(10.0)]);
+        h.record(0, f64::NAN, 16.0, 0.125, [Some(10.0), Some(10.0)]);
         assert_eq!(h, SplitHistory::new(1));
     }
 }
