@@ -27,9 +27,9 @@
 //! partner's splits, and the floor keeps every coordinate's weight positive, so one whose error
 //! its partners' splits do not remove is split once their scores have shrunk below its own.
 //!
-//! Measured (release, 2 cores, one run each): the palletizer at Dmax 3, 17,203 boxes over the
-//! feasible variants against 28,728 without the weight, the same verdicts and every gap ≤ 1e-3,
-//! `run` 61.4 s wall against 70.6 s; ten heavy variants (m4 + K42 with each parallelogram
+//! Measured (release, 2 cores): the palletizer at Dmax 3, 17,203 boxes over the feasible
+//! variants against 28,728 without the weight, the same verdicts and every gap ≤ 1e-3, `run`
+//! 63.4 s wall (median of 3) against 68.3 s; ten heavy variants (m4 + K42 with each parallelogram
 //! spring, m4 + K32 + K73, …) 4,922 boxes against 9,886. The weight of distant splits is what
 //! makes the rule safe: counted fully, the study took 16,153 boxes, but the pendulum hybrid of
 //! the critical-task tests (m1 + K10) no longer closed its gap in 2,000 boxes, against 781
@@ -104,8 +104,8 @@ impl SplitHistory {
         entry.1 += weight;
     }
 
-    /// The effect of coordinate `k`'s splits, in `[EFFECT_FLOOR, 1]`: their mean gain, shrunk
-    /// towards 1 by [`PRIOR_SPLITS`].
+    /// The effect of coordinate `k`'s splits, in `[EFFECT_FLOOR, 1]`: their weighted mean gain,
+    /// shrunk towards 1 by [`PRIOR_SPLITS`].
     pub(crate) fn effect(&self, k: usize) -> f64 {
         let (sum, n) = self.splits[k];
         ((PRIOR_SPLITS + sum) / (PRIOR_SPLITS + n)).max(EFFECT_FLOOR)
