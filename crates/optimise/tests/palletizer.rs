@@ -485,8 +485,8 @@ fn a_hybrid_whose_boxes_propose_poor_designs_is_descended_to_a_better_one() {
 /// (1,735 boxes): near the optimum the coupling error stays large on K65's anchor components,
 /// whose splits raise no bound, while K42's `b_y` splits close most of their children (410
 /// boxes with the history). Weighted by what its splits did, the search must close the same
-/// gap in at most half the boxes, each
-/// design within the gap tolerance of the other search's certified bound, both verified.
+/// gap in at most half the boxes, each design within the gap tolerance of the other search's
+/// certified bound, both verified.
 #[test]
 fn the_split_history_halves_the_heaviest_search() {
     let model = palletizer_dmax3();
