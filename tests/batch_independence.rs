@@ -1,8 +1,10 @@
 //! Sharding a study is exact only if the optimiser's result for a variant does not depend on the
-//! other variants it is batched with: `optimise_all_reporting` runs the critical-task loop, the
+//! other variants it is batched with, beyond the variants with the same counterweights that a
+//! shard holds with it: `optimise_all_reporting` runs the critical-task loop, the
 //! all-task evaluations and the final evaluation over every balanced variant at once (one
 //! parameter column per variant in the dynamics crate). This test optimises subsets of the
-//! balanced variants and compares each record with the one from the full batch, bit for bit
+//! balanced variants — whole units of the shard partition, as a shard holds them — and
+//! compares each record with the one from the full batch, bit for bit
 //! (their serde_json values: every f64 is written in its shortest round-trip form, so two
 //! values are equal exactly when the numbers are).
 
@@ -48,11 +50,25 @@ fn each_variant_optimises_to_the_same_bits_whatever_its_batch() {
         .collect();
     assert_eq!(full.len(), balanced.len());
 
-    // Subsets as a sharded run makes them: every third variant (a stride mixing classes and
-    // sizes), the second half alone, and single variants of each class.
-    let stride: Vec<usize> = (1..balanced.len()).step_by(3).collect();
-    let half: Vec<usize> = (balanced.len() / 2..balanced.len()).collect();
-    let singles = [0, balanced.len() / 2, balanced.len() - 1];
+    // Subsets as a sharded run makes them, of whole units (`shard_units`: the variants with
+    // the same counterweights and springs try each other's designs, so a shard holds all of
+    // them or none): every third unit (a stride mixing classes and sizes), the second half of
+    // the units, and single variants that are units of their own, of each class.
+    let units = counterpoise::shard::shard_units(&balanced);
+    assert!(units.iter().any(|u| u.len() > 1), "{units:?}");
+    let whole = |picked: Vec<&Vec<usize>>| -> Vec<usize> {
+        let mut ids: Vec<usize> = picked.into_iter().flatten().copied().collect();
+        ids.sort_unstable();
+        ids
+    };
+    let stride = whole(units.iter().skip(1).step_by(3).collect());
+    let half = whole(units.iter().skip(units.len() / 2).collect());
+    let alone: Vec<usize> = units
+        .iter()
+        .filter(|u| u.len() == 1)
+        .map(|u| u[0])
+        .collect();
+    let singles = [alone[0], alone[alone.len() / 2], alone[alone.len() - 1]];
     let mut subsets = vec![stride, half];
     subsets.extend(singles.iter().map(|&k| vec![k]));
     for subset in subsets {

@@ -289,7 +289,9 @@ fn merge_refuses_duplicated_foreign_and_alien_files_naming_them() {
 
 #[test]
 fn the_partition_of_the_palletizer_covers_every_balanced_variant_once_with_balanced_costs() {
-    use counterpoise::shard::{CostFeatures, ShardSpec, expected_cost, shard_variants};
+    use counterpoise::shard::{
+        CostFeatures, ShardSpec, expected_cost, shard_units, shard_variants,
+    };
     use counterpoise_balance::{
         Catalogue, SearchOptions, Status, catalogue_options, mechanism_energy, realization_hints,
         search,
@@ -316,11 +318,36 @@ fn the_partition_of_the_palletizer_covers_every_balanced_variant_once_with_balan
             .map(|&k| expected_cost(CostFeatures::of(&found.variants[k])))
             .sum()
     };
-    let largest = balanced
-        .iter()
-        .map(|&k| expected_cost(CostFeatures::of(&found.variants[k])))
-        .max()
-        .unwrap();
+    // The units kept whole: a counterweight set with springs is one (the optimiser's siblings),
+    // every other variant its own. Counted here from the labels: per counterweight label set
+    // (`m…`) of a variant with a spring (`K…`), its variants.
+    let units = shard_units(&found.variants);
+    let mut by_labels: std::collections::BTreeMap<Vec<String>, Vec<usize>> = Default::default();
+    let mut alone = Vec::new();
+    for &k in &balanced {
+        let labels: Vec<String> = found.variants[k]
+            .elements
+            .iter()
+            .map(|e| e.label.clone())
+            .collect();
+        let masses: Vec<String> = labels
+            .iter()
+            .filter(|l| l.starts_with('m'))
+            .cloned()
+            .collect();
+        if masses.is_empty() || masses.len() == labels.len() {
+            alone.push(vec![k]);
+        } else {
+            by_labels.entry(masses).or_default().push(k);
+        }
+    }
+    let mut expected: Vec<Vec<usize>> = by_labels.into_values().chain(alone).collect();
+    expected.sort();
+    let mut got = units.clone();
+    got.sort();
+    assert_eq!(got, expected);
+    assert!(units.iter().any(|u| u.len() > 1));
+    let largest = units.iter().map(|u| cost(u)).max().unwrap();
     for n in 1..=5 {
         let parts: Vec<Vec<usize>> = (1..=n)
             .map(|index| shard_variants(&found.variants, ShardSpec { index, count: n }))
@@ -331,6 +358,15 @@ fn the_partition_of_the_palletizer_covers_every_balanced_variant_once_with_balan
             all, balanced,
             "{n} shards: not every balanced variant exactly once"
         );
+        for unit in &units {
+            let holders = parts.iter().filter(|p| p.contains(&unit[0])).count();
+            assert_eq!(holders, 1);
+            let holder = parts.iter().find(|p| p.contains(&unit[0])).unwrap();
+            assert!(
+                unit.iter().all(|k| holder.contains(k)),
+                "{n} shards split {unit:?}"
+            );
+        }
         let costs: Vec<u64> = parts.iter().map(|p| cost(p)).collect();
         let (lo, hi) = (costs.iter().min().unwrap(), costs.iter().max().unwrap());
         assert!(hi - lo <= largest, "{n} shards: costs {costs:?}");

@@ -55,6 +55,11 @@ pub struct Iteration {
     /// Boxes the certified branch-and-bound solved in this pass (0: the local search's design
     /// was already within the gap tolerance of the relaxation's bound).
     pub boxes: usize,
+    /// The variant (element labels) whose counterweights the pass's design takes, when that
+    /// variant's design, tried with this variant's springs, was better than its own search's
+    /// (see the optimiser's `critical::siblings`); absent for the search's own design.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub design_from: Option<String>,
 }
 
 /// The optimisation result of one balanced variant.

@@ -145,21 +145,60 @@ pub fn partition(costs: &[u64], shards: usize) -> Vec<Vec<usize>> {
     bins
 }
 
+/// The units the partition keeps whole, as indices into `variants` (balanced variants only,
+/// each unit in enumeration order, units in the order of their first variant). The optimiser
+/// lets the variants with the same counterweights and at least one spring try each other's
+/// designs (its `critical::siblings`), so a variant's result depends on which of them the
+/// study holds: such a group is one unit, and a shard holds all of it or none, so that the
+/// merged shards equal the single run. Every other balanced variant is a unit of its own.
+pub fn shard_units(variants: &[VariantResult]) -> Vec<Vec<usize>> {
+    let mut units: Vec<Vec<usize>> = Vec::new();
+    let mut group_of: std::collections::BTreeMap<Vec<usize>, usize> = Default::default();
+    for (k, v) in variants.iter().enumerate() {
+        if v.status != counterpoise_balance::Status::Balanced {
+            continue;
+        }
+        let mut counterweights: Vec<usize> = v
+            .elements
+            .iter()
+            .filter(|e| e.kind == ElementKind::Counterweight)
+            .map(|e| e.entry)
+            .collect();
+        counterweights.sort_unstable();
+        let has_spring = v.elements.iter().any(|e| e.kind == ElementKind::Spring);
+        if counterweights.is_empty() || !has_spring {
+            units.push(vec![k]);
+            continue;
+        }
+        let unit = *group_of.entry(counterweights).or_insert_with(|| {
+            units.push(Vec::new());
+            units.len() - 1
+        });
+        units[unit].push(k);
+    }
+    units
+}
+
 /// Indices (into `variants`, the search's enumeration) of the balanced variants of shard
-/// `spec`, in enumeration order.
+/// `spec`, in enumeration order: the units of [`shard_units`], each whole, partitioned by their
+/// summed expected costs.
 pub fn shard_variants(variants: &[VariantResult], spec: ShardSpec) -> Vec<usize> {
-    let balanced: Vec<usize> = (0..variants.len())
-        .filter(|&k| variants[k].status == counterpoise_balance::Status::Balanced)
-        .collect();
-    let costs: Vec<u64> = balanced
+    let units = shard_units(variants);
+    let costs: Vec<u64> = units
         .iter()
-        .map(|&k| expected_cost(CostFeatures::of(&variants[k])))
+        .map(|unit| {
+            unit.iter()
+                .map(|&k| expected_cost(CostFeatures::of(&variants[k])))
+                .sum()
+        })
         .collect();
-    partition(&costs, spec.count)
+    let mut chosen: Vec<usize> = partition(&costs, spec.count)
         .swap_remove(spec.index - 1)
         .into_iter()
-        .map(|j| balanced[j])
-        .collect()
+        .flat_map(|u| units[u].iter().copied())
+        .collect();
+    chosen.sort_unstable();
+    chosen
 }
 
 #[cfg(test)]

@@ -310,7 +310,7 @@ pub(crate) fn bound_boxes(
 
 /// The design at a full lifted point with realized springs, if it meets every bound and peak
 /// limit on the tasks searched (and every counterweight has a positive mass).
-fn verified_design(
+pub(crate) fn verified_design(
     problem: &VariantProblem,
     tasks: &[Arc<TaskTorques>],
     objective: Objective,

@@ -15,6 +15,7 @@
 mod finish;
 mod grid;
 mod peaks;
+mod siblings;
 mod state;
 mod twin_runs;
 
@@ -200,6 +201,22 @@ fn critical_task_loop(
         if evaluated.is_empty() {
             continue;
         }
+        if options.siblings {
+            for (k, shared) in siblings::sibling_designs(ctx, runs, &evaluated, options) {
+                let cand = runs[k]
+                    .candidate
+                    .as_mut()
+                    .expect("evaluated runs have a candidate");
+                cand.x = shared.design.x;
+                cand.cws = shared.design.cws;
+                cand.springs = shared.design.springs;
+                cand.working_value = shared.design.value;
+                cand.spring_starts = Some(shared.starts);
+                cand.design_from = Some(shared.from);
+            }
+        }
+        timings.solve += started.elapsed();
+        let started = Stopwatch::start();
         let share = ShareCounter::start(
             progress,
             "all-task evaluation",
@@ -245,6 +262,7 @@ fn critical_task_loop(
                 relaxation_iterations: cand.relaxation_iterations,
                 gap_before_refinement: cand.gap_before,
                 boxes: cand.boxes,
+                design_from: cand.design_from.as_ref().map(|e| e.join(" + ")),
             });
             if added.is_empty() {
                 run.state = State::Converged;
@@ -528,6 +546,7 @@ fn candidate(
         relaxation_iterations: relaxed.solution.iterations,
         gap_before,
         spring_starts,
+        design_from: None,
     }
 }
 

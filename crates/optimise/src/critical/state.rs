@@ -41,10 +41,10 @@ pub struct OptimiseOptions {
     #[serde(default = "default_max_nodes")]
     pub max_nodes: usize,
     /// Seed of the local search's starting points after the first. Verdicts do not depend on
-    /// it, nor an objective beyond its certified gap; ranks can move where a gap stays open or
-    /// another design within the gap gives the spring choice by ΔR (a local search, not
-    /// certified) other options (at Dmax 3 on the palletizer, 96 of 788 rank numbers between
-    /// two seeds).
+    /// it, nor an objective beyond its certified gap; ranks can move where another design
+    /// within the gap gives the spring choice by ΔR (a local search, not certified) other
+    /// options, or a ΔQTR near a cell boundary crosses it (at Dmax 3 on the palletizer, 23 of
+    /// 788 rank numbers between two seeds, with [`Self::siblings`]; 96 without).
     #[serde(default = "default_start_seed")]
     pub start_seed: u64,
     /// Solve each class of mirror-twin variants once (see [`crate::twins`]): a variant whose
@@ -58,6 +58,15 @@ pub struct OptimiseOptions {
     /// error alone (to compare).
     #[serde(default = "default_split_history")]
     pub split_history: bool,
+    /// After each pass, let each variant try the designs of the pass's variants with the same
+    /// counterweights (module `critical::siblings`): the first its springs admit that is better
+    /// than its own replaces it. `false` keeps each search's own design (to compare).
+    #[serde(default = "default_siblings")]
+    pub siblings: bool,
+}
+
+pub(super) fn default_siblings() -> bool {
+    true
 }
 
 pub(super) fn default_split_history() -> bool {
@@ -214,6 +223,7 @@ impl Default for OptimiseOptions {
             start_seed: crate::springs::DEFAULT_SEED,
             twins: default_twins(),
             split_history: default_split_history(),
+            siblings: default_siblings(),
         }
     }
 }
@@ -277,12 +287,16 @@ pub(super) struct Candidate {
     pub(super) spring_starts: Option<StartRecord>,
     /// Boxes the certified search solved (0 when the fast path was within the tolerance).
     pub(super) boxes: usize,
+    /// The variant whose counterweights the design takes, when a sibling's gave a better one
+    /// than the search's own (module `siblings`).
+    pub(super) design_from: Option<Vec<String>>,
 }
 
 /// Wall and CPU time of the stages of [`optimise_all`].
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct StageTimings {
-    /// Relaxations, refinements and spring realizations of every pass.
+    /// Relaxations, refinements and spring realizations of every pass, and the designs the
+    /// siblings share (module `siblings`).
     pub solve: StageTime,
     /// The all-task torque evaluations of the critical-task loop.
     pub loop_grid: StageTime,

@@ -1,0 +1,197 @@
+//! Designs shared between the variants of a pass that have the same counterweights.
+//!
+//! The objective depends on the counterweights alone (massless springs never change a
+//! balanced variant's motor torques); a variant's springs only decide which counterweight
+//! choices are admissible. Variants with the same counterweights and other springs often admit
+//! the same best counterweights — on the palletizer, a counterweight with each of the
+//! parallelogram's springs K54, K64, K65, K74, K75, K76, whose anchors differ by a translation
+//! — yet each search ends at whichever design within the gap tolerance its own path met: at
+//! Dmax 3, m4 + K54 + K73 ended at 11.5950 N·m (ΔQTR −54.25 %) and m4 + K73 + K74 at
+//! 11.6012 N·m (−54.13 %), both certified within 1e-3 of their bounds, and another start seed
+//! swapped the two, moving each by some fifty ranks.
+//!
+//! So after each pass's searches, each such variant (its *siblings*: the pass's other variants
+//! with the same counterweight entries) tries their designs' counterweights: those that give a
+//! lower objective than its own design on its own working set, and not less than its certified
+//! bound (lower ones cannot be admissible for it), best first and at most
+//! [`SIBLING_ATTEMPTS`] of them. For each, its springs are realized for those counterweights
+//! (the pass's starts and seed) and the first design that meets every bound and peak limit
+//! replaces its own. A design is only ever replaced by a better verified one on the same tasks,
+//! so the bound and the verdict keep their meaning and the gap only shrinks; the all-task
+//! evaluation that follows checks the new design's critical tasks as it would the search's.
+//!
+//! Every variant reads its siblings' designs as the searches left them, in a fixed order, so
+//! the outcome does not depend on the thread count or on the order of work. It does depend on
+//! which siblings are in the study: a shard holds every variant of a counterweight set
+//! together (see the study crate's partition), so a sharded study merges into the single run.
+
+use std::collections::BTreeMap;
+
+use rayon::prelude::*;
+
+use super::state::{OptimiseOptions, Run, State};
+use crate::certify::{Design, verified_design};
+use crate::context::Context;
+use crate::springs::{StartRecord, realize_springs_seeded};
+
+/// At most this many siblings' counterweights are tried per variant and pass (the best
+/// first): each costs a spring realization from the pass's starts.
+pub(super) const SIBLING_ATTEMPTS: usize = 16;
+
+/// A better design for one variant, from a sibling's counterweights.
+pub(super) struct SharedDesign {
+    pub(super) design: Design,
+    pub(super) starts: StartRecord,
+    /// The sibling whose counterweights the design takes (its element labels).
+    pub(super) from: Vec<String>,
+}
+
+/// Per variant of `evaluated` (the runs with a candidate this pass, in increasing order), in
+/// that order, the better design its siblings' counterweights give, if any (see the module
+/// doc).
+pub(super) fn sibling_designs(
+    ctx: &Context,
+    runs: &[Run],
+    evaluated: &[usize],
+    options: &OptimiseOptions,
+) -> Vec<(usize, SharedDesign)> {
+    // Sources: every run with a design that still stands (this pass's, or a converged run's
+    // from an earlier pass); targets: this pass's.
+    let stands = |run: &Run| {
+        run.candidate.is_some() && matches!(run.state, State::Running | State::Converged)
+    };
+    let mut groups: BTreeMap<Vec<usize>, Vec<usize>> = BTreeMap::new();
+    for (k, run) in runs.iter().enumerate() {
+        let Some(problem) = run.problem.as_ref() else {
+            continue;
+        };
+        if problem.counterweights.is_empty() || problem.springs.is_empty() || !stands(run) {
+            continue;
+        }
+        let mut key: Vec<usize> = problem.counterweights.iter().map(|c| c.entry).collect();
+        key.sort_unstable();
+        groups.entry(key).or_default().push(k);
+    }
+    let targets: Vec<(usize, &[usize])> = groups
+        .values()
+        .filter(|g| g.len() > 1)
+        .flat_map(|g| {
+            g.iter()
+                .filter(|k| evaluated.binary_search(k).is_ok())
+                .map(move |&k| (k, g.as_slice()))
+        })
+        .collect();
+    let mut shared: Vec<(usize, SharedDesign)> = targets
+        .par_iter()
+        .with_max_len(1)
+        .filter_map(|&(k, group)| better_design(ctx, runs, k, group, options).map(|s| (k, s)))
+        .collect();
+    shared.sort_by_key(|s| s.0);
+    shared
+}
+
+/// Relative distance below which two designs' counterweights count as one design to try.
+const SAME_DESIGN: f64 = 1e-4;
+
+/// Whether runs `i` and `j`'s designs have their counterweights within [`SAME_DESIGN`] of each
+/// other (mass relative to the larger mass, first moment relative to the larger one).
+fn near_counterweights(runs: &[Run], i: usize, j: usize) -> bool {
+    let (Some(a), Some(b)) = (runs[i].candidate.as_ref(), runs[j].candidate.as_ref()) else {
+        return false;
+    };
+    a.cws.iter().zip(&b.cws).all(|(p, q)| {
+        let norm = |mu: &[f64; 3]| mu.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let dmu = [p.mu[0] - q.mu[0], p.mu[1] - q.mu[1], p.mu[2] - q.mu[2]];
+        (p.mass - q.mass).abs() <= SAME_DESIGN * p.mass.abs().max(q.mass.abs())
+            && norm(&dmu) <= SAME_DESIGN * norm(&p.mu).max(norm(&q.mu))
+    })
+}
+
+/// The best of the siblings' counterweights that run `k`'s springs admit, when it is better
+/// than `k`'s own design (see the module doc).
+fn better_design(
+    ctx: &Context,
+    runs: &[Run],
+    k: usize,
+    group: &[usize],
+    options: &OptimiseOptions,
+) -> Option<SharedDesign> {
+    let run = &runs[k];
+    let problem = run.problem.as_ref()?;
+    let own = run.candidate.as_ref()?;
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+    let shared_springs = |j: usize| {
+        runs[j].problem.as_ref().map_or(0, |theirs| {
+            theirs
+                .springs
+                .iter()
+                .filter(|s| problem.springs.iter().any(|t| t.entry == s.entry))
+                .count()
+        })
+    };
+    let mut offers: Vec<(usize, f64, usize)> = group
+        .iter()
+        .filter(|&&j| j != k)
+        .filter_map(|&j| {
+            let theirs = runs[j].candidate.as_ref()?;
+            let value = problem
+                .evaluate(&theirs.cws, &tasks)
+                .objective(options.objective, problem.actuators);
+            (value >= own.lower_bound && value < own.working_value).then_some((
+                shared_springs(j),
+                value,
+                j,
+            ))
+        })
+        .collect();
+    // Siblings that share more springs first (their admissible counterweights are more
+    // alike), then the lower objective, then the run order.
+    offers.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
+    // Siblings near one design (mirror twins, springs that load other joints, searches that
+    // stopped within the gap of one optimum) offer it once: the first of them is tried.
+    let mut tried: Vec<usize> = Vec::new();
+    offers.retain(|&(_, _, j)| {
+        let near = tried.iter().any(|&i| near_counterweights(runs, i, j));
+        if !near {
+            tried.push(j);
+        }
+        !near
+    });
+    let b = &ctx.basis.unbalanced;
+    for &(_, _, j) in offers.iter().take(SIBLING_ATTEMPTS) {
+        let theirs = runs[j].candidate.as_ref()?;
+        let their_problem = runs[j].problem.as_ref()?;
+        // Their counterweights' lifted columns (mass, first moment) in place of this run's:
+        // the same entries, so the same axes; the springs are realized for them below.
+        let mut x = own.x.clone();
+        for mine in &problem.counterweights {
+            let their = their_problem
+                .counterweights
+                .iter()
+                .find(|c| c.entry == mine.entry)?;
+            for r in 0..=mine.axes.len() {
+                x[mine.column + r] = theirs.x[their.column + r];
+            }
+        }
+        let (found, _, starts) = realize_springs_seeded(
+            problem,
+            b,
+            &x,
+            options.spring_starts,
+            false,
+            None,
+            options.start_seed,
+        );
+        let design = found.into_iter().find_map(|(springs, x_full)| {
+            verified_design(problem, &tasks, options.objective, springs, x_full)
+        });
+        if let Some(design) = design.filter(|d| d.value < own.working_value) {
+            return Some(SharedDesign {
+                design,
+                starts,
+                from: runs[j].elements.clone(),
+            });
+        }
+    }
+    None
+}
