@@ -53,7 +53,8 @@ fn each_variant_optimises_to_the_same_bits_whatever_its_batch() {
     // Subsets as a sharded run makes them, of whole units (`shard_units`: the variants with
     // the same counterweights and springs try each other's designs, so a shard holds all of
     // them or none): every third unit (a stride mixing classes and sizes), the second half of
-    // the units, and single variants that are units of their own, of each class.
+    // the units, and single variants that are units of their own (springs alone or
+    // counterweights alone: every hybrid shares its counterweights with a sibling here).
     let units = counterpoise::shard::shard_units(&balanced);
     assert!(units.iter().any(|u| u.len() > 1), "{units:?}");
     let whole = |picked: Vec<&Vec<usize>>| -> Vec<usize> {

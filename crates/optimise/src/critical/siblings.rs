@@ -32,6 +32,7 @@ use rayon::prelude::*;
 use super::state::{OptimiseOptions, Run, State};
 use crate::certify::{Design, verified_design};
 use crate::context::Context;
+use crate::slots::CwPhysical;
 use crate::springs::{StartRecord, realize_springs_seeded};
 
 /// At most this many siblings' counterweights are tried per variant and pass (the best
@@ -93,17 +94,15 @@ pub(super) fn sibling_designs(
 /// Relative distance below which two designs' counterweights count as one design to try.
 const SAME_DESIGN: f64 = 1e-4;
 
-/// Whether runs `i` and `j`'s designs have their counterweights within [`SAME_DESIGN`] of each
-/// other (mass relative to the larger mass, first moment relative to the larger one).
-fn near_counterweights(runs: &[Run], i: usize, j: usize) -> bool {
-    let (Some(a), Some(b)) = (runs[i].candidate.as_ref(), runs[j].candidate.as_ref()) else {
-        return false;
-    };
-    a.cws.iter().zip(&b.cws).all(|(p, q)| {
-        let norm = |mu: &[f64; 3]| mu.iter().map(|v| v * v).sum::<f64>().sqrt();
+/// Whether two designs' counterweights (the same entries, in order) are within
+/// [`SAME_DESIGN`] of each other: each mass relative to the larger of the two, each first
+/// moment's difference relative to the larger first moment.
+fn near_counterweights(a: &[CwPhysical], b: &[CwPhysical]) -> bool {
+    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    a.iter().zip(b).all(|(p, q)| {
         let dmu = [p.mu[0] - q.mu[0], p.mu[1] - q.mu[1], p.mu[2] - q.mu[2]];
         (p.mass - q.mass).abs() <= SAME_DESIGN * p.mass.abs().max(q.mass.abs())
-            && norm(&dmu) <= SAME_DESIGN * norm(&p.mu).max(norm(&q.mu))
+            && norm(dmu) <= SAME_DESIGN * norm(p.mu).max(norm(q.mu))
     })
 }
 
@@ -149,9 +148,15 @@ fn better_design(
     offers.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
     // Siblings near one design (mirror twins, springs that load other joints, searches that
     // stopped within the gap of one optimum) offer it once: the first of them is tried.
+    let cws = |j: usize| {
+        runs[j]
+            .candidate
+            .as_ref()
+            .map_or(&[][..], |c| c.cws.as_slice())
+    };
     let mut tried: Vec<usize> = Vec::new();
     offers.retain(|&(_, _, j)| {
-        let near = tried.iter().any(|&i| near_counterweights(runs, i, j));
+        let near = tried.iter().any(|&i| near_counterweights(cws(i), cws(j)));
         if !near {
             tried.push(j);
         }
@@ -194,4 +199,54 @@ fn better_design(
         }
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cw(mass: f64, mu: [f64; 3]) -> CwPhysical {
+        CwPhysical { mass, mu }
+    }
+
+    #[test]
+    fn designs_within_the_relative_distance_count_as_one() {
+        let a = [cw(20.0, [3.0, -4.0, 0.0])];
+        assert!(near_counterweights(&a, &a));
+        // Mass: 1e-4 of the larger mass is 2e-3 kg; half of it is near, twice it is not.
+        assert!(near_counterweights(&a, &[cw(20.001, [3.0, -4.0, 0.0])]));
+        assert!(near_counterweights(&[cw(20.001, [3.0, -4.0, 0.0])], &a));
+        assert!(!near_counterweights(&a, &[cw(20.004, [3.0, -4.0, 0.0])]));
+        assert!(!near_counterweights(&a, &[cw(19.996, [3.0, -4.0, 0.0])]));
+        // First moment: |μ| = 5 kg·m, so 5e-4 kg·m in any direction (a 3-4-5 step of
+        // (1.2e-4, 1.6e-4, 0) is 2e-4: near; (3e-4, 4e-4, 0) is exactly 5e-4: near; twice
+        // that along z is not).
+        assert!(near_counterweights(
+            &a,
+            &[cw(20.0, [3.00012, -3.99984, 0.0])]
+        ));
+        assert!(near_counterweights(&a, &[cw(20.0, [3.0003, -4.0004, 0.0])]));
+        assert!(!near_counterweights(&a, &[cw(20.0, [3.0, -4.0, 1e-3])]));
+        assert!(!near_counterweights(&a, &[cw(20.0, [3.0, -4.0, -1e-3])]));
+        assert!(!near_counterweights(&a, &[cw(20.0, [2.999, -4.0, 0.0])]));
+        assert!(!near_counterweights(&a, &[cw(20.0, [3.0, -3.999, 0.0])]));
+        // The mirror image is another design.
+        assert!(!near_counterweights(&a, &[cw(20.0, [-3.0, 4.0, 0.0])]));
+        // The larger first moment sets the scale: 1e-3 kg·m against |μ| = 10 is near.
+        assert!(near_counterweights(
+            &[cw(20.0, [0.0, 10.0, 0.0])],
+            &[cw(20.0, [0.0, 10.0, 1e-3])]
+        ));
+        // Every counterweight must be near.
+        let two = [cw(20.0, [3.0, -4.0, 0.0]), cw(5.0, [0.0, 0.0, 1.0])];
+        assert!(near_counterweights(&two, &two));
+        assert!(!near_counterweights(
+            &two,
+            &[cw(20.0, [3.0, -4.0, 0.0]), cw(5.1, [0.0, 0.0, 1.0])]
+        ));
+        assert!(!near_counterweights(
+            &two,
+            &[cw(20.1, [3.0, -4.0, 0.0]), cw(5.0, [0.0, 0.0, 1.0])]
+        ));
+    }
 }
