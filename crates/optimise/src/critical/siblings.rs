@@ -10,15 +10,22 @@
 //! 11.6012 N·m (−54.13 %), both certified within 1e-3 of their bounds, and another start seed
 //! swapped the two, moving each by some fifty ranks.
 //!
-//! So after each pass's searches, each such variant (its *siblings*: the pass's other variants
-//! with the same counterweight entries) tries their designs' counterweights: those that give a
-//! lower objective than its own design on its own working set, and not less than its certified
-//! bound (lower ones cannot be admissible for it), best first and at most
-//! [`SIBLING_ATTEMPTS`] of them. For each, its springs are realized for those counterweights
-//! (the pass's starts and seed) and the first design that meets every bound and peak limit
-//! replaces its own. A design is only ever replaced by a better verified one on the same tasks,
-//! so the bound and the verdict keep their meaning and the gap only shrinks; the all-task
-//! evaluation that follows checks the new design's critical tasks as it would the search's.
+//! So after each pass's searches, each such variant tries the designs of its *siblings* (the
+//! study's other variants with the same counterweight entries and springs that have a design:
+//! this pass's, or one that converged in an earlier pass): the counterweights that give a lower
+//! objective than its own design on its own working set, and not less than its certified bound
+//! (lower ones cannot be admissible for it). Siblings that share more of its springs come
+//! first (their admissible counterweights are more alike: at the m6 optimum, dozens of designs
+//! that need other springs would otherwise use up the tries), then the lower objective; designs
+//! within [`SAME_DESIGN`] of one already listed are tried once; at most [`SIBLING_ATTEMPTS`].
+//! For each, its springs are realized for those counterweights (the pass's starts and seed; only
+//! solutions that balance are returned) and the first design that meets every bound and peak
+//! limit replaces its own. A design is only ever replaced by a better verified one on the same
+//! tasks, so the bound and the verdict keep their meaning and the gap only shrinks; the
+//! all-task evaluation that follows checks the new design's critical tasks as it would the
+//! search's. Variants without counterweights take no part (their objective is the same at
+//! every design), nor do those without springs (there would be no realization to check the
+//! balance of another variant's counterweights).
 //!
 //! Every variant reads its siblings' designs as the searches left them, in a fixed order, so
 //! the outcome does not depend on the thread count or on the order of work. It does depend on
@@ -35,8 +42,8 @@ use crate::context::Context;
 use crate::slots::CwPhysical;
 use crate::springs::{StartRecord, realize_springs_seeded};
 
-/// At most this many siblings' counterweights are tried per variant and pass (the best
-/// first): each costs a spring realization from the pass's starts.
+/// At most this many siblings' designs are tried per variant and pass (in the order of the
+/// module doc): each costs a spring realization from the pass's starts.
 pub(super) const SIBLING_ATTEMPTS: usize = 16;
 
 /// A better design for one variant, from a sibling's counterweights.
