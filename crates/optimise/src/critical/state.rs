@@ -58,9 +58,10 @@ pub struct OptimiseOptions {
     /// error alone (to compare).
     #[serde(default = "default_split_history")]
     pub split_history: bool,
-    /// After each pass, let each variant try the designs of the pass's variants with the same
-    /// counterweights (module `critical::siblings`): the first its springs admit that is better
-    /// than its own replaces it. `false` keeps each search's own design (to compare).
+    /// After each pass, let each variant try the designs of the study's variants with the same
+    /// counterweights and springs (module `critical::siblings`): the first its springs admit
+    /// that is better than its own replaces it. `false` keeps each search's own design (to
+    /// compare).
     #[serde(default = "default_siblings")]
     pub siblings: bool,
 }
