@@ -1410,3 +1410,58 @@ fn a_twin_of_a_discarded_variant_is_discarded_by_the_same_proof() {
         )
     );
 }
+
+/// A variant without springs takes no part in the sharing (module `siblings`): another
+/// variant's counterweights balance it only if they lie on its own balanced family, and
+/// with no spring to realize nothing would check that. At Dmax 3, m4 + m5 (counterweights
+/// only, 12.370 N·m) and m4 + m5 + K43 (11.604 N·m) have the same counterweights; with m4 +
+/// m5's certified bound taken down to 0, the hybrid's design lies in its window (below its
+/// own value on its own working set, computed here), yet it is offered nothing, while those
+/// counterweights are off m4 + m5's family (the least-squares residual of the lifted point
+/// against the family, by the nullspace, is far above rounding).
+#[test]
+fn a_variant_without_springs_never_takes_a_siblings_counterweights() {
+    let model = palletizer_dmax3();
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let alone = run_after_loop(&ctx, &balanced_variant(&model, &["m4", "m5"]), &options);
+    let hybrid = run_after_loop(
+        &ctx,
+        &balanced_variant(&model, &["m4", "m5", "K43"]),
+        &options,
+    );
+    let mut runs = vec![alone, hybrid];
+    let own = runs[0].candidate.as_mut().unwrap();
+    own.lower_bound = 0.0;
+    let own_value = own.working_value;
+    let theirs = runs[1].candidate.as_ref().unwrap();
+    let problem = runs[0].problem.as_ref().unwrap();
+    // The window: the hybrid's counterweights on m4 + m5's working set.
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &runs[0].working);
+    let value = problem
+        .evaluate(&theirs.cws, &tasks)
+        .objective(options.objective, problem.actuators);
+    assert!(value < own_value, "{value} against {own_value}");
+    // Off the family: the hybrid's mass and first moments in m4 + m5's lifted point.
+    let their_problem = runs[1].problem.as_ref().unwrap();
+    let mut x = runs[0].candidate.as_ref().unwrap().x.clone();
+    for mine in &problem.counterweights {
+        let their = their_problem
+            .counterweights
+            .iter()
+            .find(|c| c.entry == mine.entry)
+            .unwrap();
+        for r in 0..=mine.axes.len() {
+            x[mine.column + r] = theirs.x[their.column + r];
+        }
+    }
+    let z = crate::refine::free_coordinates(problem, &x).unwrap();
+    let residual = (problem.lifted(&z) - &x).norm() / x.norm();
+    assert!(residual > 1e-6, "{residual}");
+    let shared = siblings::sibling_designs(&ctx, &runs, &[0, 1], &options);
+    assert!(
+        shared.iter().all(|(k, _)| *k != 0),
+        "m4 + m5 took {:?}",
+        shared.iter().map(|(_, s)| &s.from).collect::<Vec<_>>()
+    );
+}
