@@ -113,6 +113,44 @@ fn near_counterweights(a: &[CwPhysical], b: &[CwPhysical]) -> bool {
     })
 }
 
+/// A sibling's design offered to a variant.
+struct Offer<'a> {
+    /// How many of the variant's springs the sibling has too.
+    shared_springs: usize,
+    /// The design's objective on the variant's working set.
+    value: f64,
+    /// The sibling's run.
+    run: usize,
+    /// The design's counterweights.
+    cws: &'a [CwPhysical],
+}
+
+/// The runs whose designs a variant tries, in order (see the module doc): the offers whose
+/// value lies in `[lower_bound, own_value)` — below its certified bound a design cannot be
+/// admissible for it, at or above its own value it is no better — those sharing more springs
+/// first, then the lower value, then the run order; of designs near one another
+/// ([`near_counterweights`]: mirror twins, springs that load other joints, searches that
+/// stopped within the gap of one optimum), the first only.
+fn offers_to_try(mut offers: Vec<Offer>, lower_bound: f64, own_value: f64) -> Vec<usize> {
+    offers.retain(|o| o.value >= lower_bound && o.value < own_value);
+    offers.sort_by(|a, b| {
+        b.shared_springs
+            .cmp(&a.shared_springs)
+            .then(a.value.total_cmp(&b.value))
+            .then(a.run.cmp(&b.run))
+    });
+    let mut distinct: Vec<Offer> = Vec::new();
+    for offer in offers {
+        if !distinct
+            .iter()
+            .any(|d| near_counterweights(d.cws, offer.cws))
+        {
+            distinct.push(offer);
+        }
+    }
+    distinct.into_iter().map(|o| o.run).collect()
+}
+
 /// The best of the siblings' counterweights that run `k`'s springs admit, when it is better
 /// than `k`'s own design (see the module doc).
 fn better_design(
@@ -135,7 +173,7 @@ fn better_design(
                 .count()
         })
     };
-    let mut offers: Vec<(usize, f64, usize)> = group
+    let offers: Vec<Offer> = group
         .iter()
         .filter(|&&j| j != k)
         .filter_map(|&j| {
@@ -143,34 +181,17 @@ fn better_design(
             let value = problem
                 .evaluate(&theirs.cws, &tasks)
                 .objective(options.objective, problem.actuators);
-            (value >= own.lower_bound && value < own.working_value).then_some((
-                shared_springs(j),
+            Some(Offer {
+                shared_springs: shared_springs(j),
                 value,
-                j,
-            ))
+                run: j,
+                cws: &theirs.cws,
+            })
         })
         .collect();
-    // Siblings that share more springs first (their admissible counterweights are more
-    // alike), then the lower objective, then the run order.
-    offers.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
-    // Siblings near one design (mirror twins, springs that load other joints, searches that
-    // stopped within the gap of one optimum) offer it once: the first of them is tried.
-    let cws = |j: usize| {
-        runs[j]
-            .candidate
-            .as_ref()
-            .map_or(&[][..], |c| c.cws.as_slice())
-    };
-    let mut tried: Vec<usize> = Vec::new();
-    offers.retain(|&(_, _, j)| {
-        let near = tried.iter().any(|&i| near_counterweights(cws(i), cws(j)));
-        if !near {
-            tried.push(j);
-        }
-        !near
-    });
+    let order = offers_to_try(offers, own.lower_bound, own.working_value);
     let b = &ctx.basis.unbalanced;
-    for &(_, _, j) in offers.iter().take(SIBLING_ATTEMPTS) {
+    for &j in order.iter().take(SIBLING_ATTEMPTS) {
         let theirs = runs[j].candidate.as_ref()?;
         let their_problem = runs[j].problem.as_ref()?;
         // Their counterweights' lifted columns (mass, first moment) in place of this run's:
@@ -214,6 +235,36 @@ mod tests {
 
     fn cw(mass: f64, mu: [f64; 3]) -> CwPhysical {
         CwPhysical { mass, mu }
+    }
+
+    /// By hand, a variant with certified bound 10 and its own design at 12 N·m: 9.9 lies below
+    /// its bound and 12.0 is its own value, both out; 10.0 (the bound itself) and the rest are
+    /// in. Sharing two springs first (runs 4, 5, 6: values 10.0, 10.5, 10.5, the equal values
+    /// by run order), then one (runs 3, 7: 10.2, 11.0); run 8 (10.9, two springs, so before
+    /// runs 3 and 7) has counterweights within 1e-4 of run 6's and is left out as the same
+    /// design.
+    #[test]
+    fn offers_in_the_window_by_shared_springs_then_value_then_run_one_per_design() {
+        let design = |m: f64| vec![cw(m, [1.0, 2.0, 0.0])];
+        let designs: Vec<Vec<CwPhysical>> = (0..10).map(|r| design(10.0 + r as f64)).collect();
+        let near_six = design(16.0001);
+        let offer = |shared_springs: usize, value: f64, run: usize| Offer {
+            shared_springs,
+            value,
+            run,
+            cws: if run == 8 { &near_six } else { &designs[run] },
+        };
+        let offers = vec![
+            offer(2, 9.9, 1),
+            offer(2, 12.0, 2),
+            offer(1, 10.2, 3),
+            offer(2, 10.0, 4),
+            offer(2, 10.5, 6),
+            offer(2, 10.5, 5),
+            offer(1, 11.0, 7),
+            offer(2, 10.9, 8),
+        ];
+        assert_eq!(offers_to_try(offers, 10.0, 12.0), [4, 5, 6, 3, 7]);
     }
 
     #[test]
