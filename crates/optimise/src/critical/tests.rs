@@ -1465,3 +1465,32 @@ fn a_variant_without_springs_never_takes_a_siblings_counterweights() {
         shared.iter().map(|(_, s)| &s.from).collect::<Vec<_>>()
     );
 }
+
+/// Only a design that still stands is offered (module `siblings`): at Dmax 3, m6 + K53 + K74
+/// alone ends above m6 + K53 + K54 alone, and takes its counterweights when both stand; once
+/// m6 + K53 + K54's run no longer stands (here marked discarded, as a failed all-task check
+/// would), its last design is offered to nobody.
+#[test]
+fn siblings_offer_only_designs_that_still_stand() {
+    let model = palletizer_dmax3();
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let mut runs: Vec<Run> = [["m6", "K53", "K54"], ["m6", "K53", "K74"]]
+        .iter()
+        .map(|labels| run_after_loop(&ctx, &balanced_variant(&model, labels), &options))
+        .collect();
+    let value = |run: &Run| run.candidate.as_ref().unwrap().working_value;
+    assert!(value(&runs[1]) > value(&runs[0]));
+    let shared = siblings::sibling_designs(&ctx, &runs, &[0, 1], &options);
+    assert_eq!(shared.len(), 1);
+    assert_eq!(shared[0].0, 1);
+    assert_eq!(shared[0].1.from, ["m6", "K53", "K54"]);
+    assert!(shared[0].1.design.value < value(&runs[1]));
+    runs[0].state = State::Discarded("a peak limit over all tasks".into());
+    let shared = siblings::sibling_designs(&ctx, &runs, &[0, 1], &options);
+    assert!(
+        shared.is_empty(),
+        "{:?}",
+        shared.iter().map(|s| &s.1.from).collect::<Vec<_>>()
+    );
+}
