@@ -46,6 +46,7 @@ pub use context::Context;
 pub use critical::{
     FinalReactionSolve, LoopTorques, OptimiseOptions, StageTimings, delta_r, lowest_delta_r,
     objective_of, optimise_all, optimise_all_reporting, optimise_all_timed, optimise_variant,
+    sibling_group,
 };
 pub use error::OptimiseError;
 pub use overrides::{BoundsTable, CounterweightBounds, ElementBounds, SpringBounds};

@@ -148,8 +148,9 @@ pub fn partition(costs: &[u64], shards: usize) -> Vec<Vec<usize>> {
 /// The units the partition keeps whole, as indices into `variants` (balanced variants only,
 /// each unit in enumeration order, units in the order of their first variant). The optimiser
 /// lets the variants with the same counterweights and at least one spring try each other's
-/// designs (its `critical::siblings`), so a variant's result depends on which of them the
-/// study holds: such a group is one unit, and a shard holds all of it or none, so that the
+/// designs (its `critical::siblings`, grouped by [`counterpoise_optimise::sibling_group`],
+/// the key used here too), so a variant's result depends on which of them the study holds:
+/// such a group is one unit, and a shard holds all of it or none, so that the
 /// merged shards equal the single run. Every other balanced variant is a unit of its own.
 pub fn shard_units(variants: &[VariantResult]) -> Vec<Vec<usize>> {
     let mut units: Vec<Vec<usize>> = Vec::new();
@@ -158,19 +159,17 @@ pub fn shard_units(variants: &[VariantResult]) -> Vec<Vec<usize>> {
         if v.status != counterpoise_balance::Status::Balanced {
             continue;
         }
-        let mut counterweights: Vec<usize> = v
+        let counterweights = v
             .elements
             .iter()
             .filter(|e| e.kind == ElementKind::Counterweight)
-            .map(|e| e.entry)
-            .collect();
-        counterweights.sort_unstable();
+            .map(|e| e.entry);
         let has_spring = v.elements.iter().any(|e| e.kind == ElementKind::Spring);
-        if counterweights.is_empty() || !has_spring {
+        let Some(group) = counterpoise_optimise::sibling_group(counterweights, has_spring) else {
             units.push(vec![k]);
             continue;
-        }
-        let unit = *group_of.entry(counterweights).or_insert_with(|| {
+        };
+        let unit = *group_of.entry(group).or_insert_with(|| {
             units.push(Vec::new());
             units.len() - 1
         });

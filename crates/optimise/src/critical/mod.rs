@@ -43,6 +43,7 @@ use state::*;
 
 pub use grid::objective_of;
 pub use peaks::{delta_r, lowest_delta_r};
+pub use siblings::sibling_group;
 pub use state::{FinalReactionSolve, LoopTorques, OptimiseOptions, StageTimings};
 
 /// Optimises one balanced variant (see [`optimise_all`]).

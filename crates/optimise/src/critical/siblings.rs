@@ -34,11 +34,13 @@
 
 use std::collections::BTreeMap;
 
+use nalgebra::DVector;
 use rayon::prelude::*;
 
 use super::state::{OptimiseOptions, Run, State};
 use crate::certify::{Design, verified_design};
 use crate::context::Context;
+use crate::problem::VariantProblem;
 use crate::slots::CwPhysical;
 use crate::springs::{StartRecord, realize_springs_seeded};
 
@@ -73,12 +75,13 @@ pub(super) fn sibling_designs(
         let Some(problem) = run.problem.as_ref() else {
             continue;
         };
-        if problem.counterweights.is_empty() || problem.springs.is_empty() || !stands(run) {
+        let entries = problem.counterweights.iter().map(|c| c.entry);
+        let Some(key) = sibling_group(entries, !problem.springs.is_empty()) else {
             continue;
+        };
+        if stands(run) {
+            groups.entry(key).or_default().push(k);
         }
-        let mut key: Vec<usize> = problem.counterweights.iter().map(|c| c.entry).collect();
-        key.sort_unstable();
-        groups.entry(key).or_default().push(k);
     }
     let targets: Vec<(usize, &[usize])> = groups
         .values()
@@ -96,6 +99,40 @@ pub(super) fn sibling_designs(
         .collect();
     shared.sort_by_key(|s| s.0);
     shared
+}
+
+/// The group of siblings a variant belongs to: its counterweights' catalogue entries, sorted,
+/// when it has counterweights and at least one spring; `None` for a variant that takes no part
+/// (see the module doc). The study's shard partition keeps each group whole with this same key.
+pub fn sibling_group(
+    counterweight_entries: impl IntoIterator<Item = usize>,
+    has_spring: bool,
+) -> Option<Vec<usize>> {
+    let mut key: Vec<usize> = counterweight_entries.into_iter().collect();
+    key.sort_unstable();
+    (!key.is_empty() && has_spring).then_some(key)
+}
+
+/// `x` with the counterweights' lifted columns (mass, first moment) of another variant's point
+/// `their_x` (the same counterweight entries, so the same axes), `None` when one of them is
+/// missing from `their_problem`.
+pub(super) fn with_their_counterweights(
+    problem: &VariantProblem,
+    x: &DVector<f64>,
+    their_problem: &VariantProblem,
+    their_x: &DVector<f64>,
+) -> Option<DVector<f64>> {
+    let mut x = x.clone();
+    for mine in &problem.counterweights {
+        let their = their_problem
+            .counterweights
+            .iter()
+            .find(|c| c.entry == mine.entry)?;
+        for r in 0..=mine.axes.len() {
+            x[mine.column + r] = their_x[their.column + r];
+        }
+    }
+    Some(x)
 }
 
 /// Relative distance below which two designs' counterweights count as one design to try.
@@ -194,18 +231,8 @@ fn better_design(
     for &j in order.iter().take(SIBLING_ATTEMPTS) {
         let theirs = runs[j].candidate.as_ref()?;
         let their_problem = runs[j].problem.as_ref()?;
-        // Their counterweights' lifted columns (mass, first moment) in place of this run's:
-        // the same entries, so the same axes; the springs are realized for them below.
-        let mut x = own.x.clone();
-        for mine in &problem.counterweights {
-            let their = their_problem
-                .counterweights
-                .iter()
-                .find(|c| c.entry == mine.entry)?;
-            for r in 0..=mine.axes.len() {
-                x[mine.column + r] = theirs.x[their.column + r];
-            }
-        }
+        // Their counterweights in place of this run's; the springs are realized for them below.
+        let x = with_their_counterweights(problem, &own.x, their_problem, &theirs.x)?;
         let (found, _, starts) = realize_springs_seeded(
             problem,
             b,
@@ -265,6 +292,16 @@ mod tests {
             offer(2, 10.9, 8),
         ];
         assert_eq!(offers_to_try(offers, 10.0, 12.0), [4, 5, 6, 3, 7]);
+    }
+
+    /// By hand: counterweights 3 and 1 with a spring group as [1, 3] (the order of the
+    /// elements does not matter); without a spring, or without a counterweight, no group.
+    #[test]
+    fn a_group_is_the_sorted_counterweights_of_a_variant_with_a_spring() {
+        assert_eq!(sibling_group([3, 1], true), Some(vec![1, 3]));
+        assert_eq!(sibling_group([1, 3], true), Some(vec![1, 3]));
+        assert_eq!(sibling_group([3, 1], false), None);
+        assert_eq!(sibling_group([], true), None);
     }
 
     #[test]

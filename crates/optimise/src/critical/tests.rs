@@ -1444,17 +1444,8 @@ fn a_variant_without_springs_never_takes_a_siblings_counterweights() {
     assert!(value < own_value, "{value} against {own_value}");
     // Off the family: the hybrid's mass and first moments in m4 + m5's lifted point.
     let their_problem = runs[1].problem.as_ref().unwrap();
-    let mut x = runs[0].candidate.as_ref().unwrap().x.clone();
-    for mine in &problem.counterweights {
-        let their = their_problem
-            .counterweights
-            .iter()
-            .find(|c| c.entry == mine.entry)
-            .unwrap();
-        for r in 0..=mine.axes.len() {
-            x[mine.column + r] = theirs.x[their.column + r];
-        }
-    }
+    let own_x = &runs[0].candidate.as_ref().unwrap().x;
+    let x = siblings::with_their_counterweights(problem, own_x, their_problem, &theirs.x).unwrap();
     let z = crate::refine::free_coordinates(problem, &x).unwrap();
     let residual = (problem.lifted(&z) - &x).norm() / x.norm();
     assert!(residual > 1e-6, "{residual}");
