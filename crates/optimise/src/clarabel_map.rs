@@ -164,6 +164,10 @@ pub struct ConicSolution {
     pub objective: f64,
     /// The dual objective: a lower bound on the optimum when the dual is feasible.
     pub dual_objective: f64,
+    /// The dual variables, one per row in the order the rows were added (clarabel's `z`): for
+    /// a feasible dual, the objective at any feasible point is at least the dual objective
+    /// plus `Σ z_r·e_r(x)` over any rows `e_r ≥ 0` (weak duality, every term ≥ 0).
+    pub dual: Vec<f64>,
     pub iterations: u32,
     /// Solver runs (1 unless retried).
     pub attempts: u32,
@@ -343,6 +347,7 @@ impl ConicProblem {
             x: vec![0.0; n],
             objective: f64::NAN,
             dual_objective: f64::NAN,
+            dual: vec![0.0; m],
             iterations: 0,
             attempts: 1,
             tolerance: f64::NAN,
@@ -360,6 +365,7 @@ impl ConicProblem {
             x: s.x.clone(),
             objective: s.obj_val,
             dual_objective: s.obj_val_dual,
+            dual: s.z.clone(),
             iterations: s.iterations,
             attempts: 1,
             tolerance: settings_tol,

@@ -113,6 +113,36 @@ pub struct Relaxed {
     /// `μμᵀ/m` and `m^{5/3}` at the relaxed `(m, μ)`, relative to their scales (0 when solved
     /// exactly; what the branch-and-bound splits to remove).
     pub cw_errors: Vec<f64>,
+    /// On a box, the ends of the branching coordinates whose rows the dual weighs (see
+    /// [`EndRate`]). Empty without a box or a solved relaxation.
+    pub reduced: Vec<EndRate>,
+}
+
+/// The dual rate of one end of a box's branching coordinate: every point of the box's
+/// relaxation has an objective of at least its bound plus `rate·d`, `d` the coordinate's
+/// distance from that end of its interval (weak duality on the end's row, whose value is at
+/// least `per_unit·d`; see [`NodeRow`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EndRate {
+    /// The coordinate, in [`crate::certify::node::coordinates`] order.
+    pub coordinate: usize,
+    /// The upper end (else the lower).
+    pub upper: bool,
+    /// Objective units per unit of the coordinate, > 0.
+    pub rate: f64,
+}
+
+/// A row of a box that bounds one branching coordinate (in [`crate::certify::node::coordinates`]
+/// order) on one side: its value is at least `per_unit` times the coordinate's distance from
+/// that end of its interval (`K·(a_i − lo)/A` for an anchor, with `K ≥ K_lo` and `A` the
+/// lifted column's scale; `(m − lo)/M` for a mass; `(μ_k − lo)/R` for a first moment; and
+/// likewise from the upper end).
+#[derive(Clone, Copy, Debug)]
+struct NodeRow {
+    coordinate: usize,
+    upper: bool,
+    row: usize,
+    per_unit: f64,
 }
 
 /// Index of the `S` entry `(a, b)`, `a ≤ b`, among a counterweight's axes pairs.
@@ -302,6 +332,8 @@ struct Built {
     tau_scale: f64,
     natural: Vec<f64>,
     cw_vars: Vec<CwVars>,
+    /// The box's rows that bound its coordinates (empty without a box).
+    node_rows: Vec<NodeRow>,
 }
 
 /// A counterweight's own conic variables: its normalised second moments (one per pair of plane
@@ -366,6 +398,21 @@ impl Built {
                 error
             })
             .collect();
+        let reduced = if solution.status == ConicStatus::Solved {
+            self.node_rows
+                .iter()
+                .filter_map(|r| {
+                    let rate = self.tau_scale * solution.dual.get(r.row)?.max(0.0) * r.per_unit;
+                    (rate > 0.0 && rate.is_finite()).then_some(EndRate {
+                        coordinate: r.coordinate,
+                        upper: r.upper,
+                        rate,
+                    })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         Relaxed {
             bound: self.tau_scale
                 * solution.objective.min(solution.dual_objective)
@@ -373,6 +420,7 @@ impl Built {
             z: zv,
             solution,
             cw_errors,
+            reduced,
         }
     }
 }
@@ -625,6 +673,13 @@ pub fn lagrange_terms(s: &crate::slots::SpringSlot) -> Vec<Vec<(usize, f64)>> {
 /// Appends a node's rows (see [`solve_relaxation_in`]).
 fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
     let natural = built.natural.clone();
+    // The branching coordinates' order (`certify::node::coordinates`): every spring's anchor
+    // components, then every counterweight's mass and first moments.
+    let mut next_coordinate: usize = problem
+        .springs
+        .iter()
+        .map(|s| s.axes_a.len() + s.axes_b.len())
+        .sum();
     for (cw, c) in problem.counterweights.iter().enumerate() {
         let vars = built.cw_vars[cw].clone();
         let big_m = natural[c.column];
@@ -643,6 +698,21 @@ fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
         let cp = &mut built.cp;
         let [lo, hi] = node.mass(problem, cw);
         let intervals: Vec<[f64; 2]> = (0..n_ax).map(|k| node.moment(problem, cw, k)).collect();
+        // `within` adds the lower side's row, then the upper's.
+        for (k, per_unit) in std::iter::once(1.0 / big_m)
+            .chain((0..n_ax).map(|_| 1.0 / big_r))
+            .enumerate()
+        {
+            for upper in [false, true] {
+                built.node_rows.push(NodeRow {
+                    coordinate: next_coordinate + k,
+                    upper,
+                    row: cp.rows() + 2 * k + usize::from(upper),
+                    per_unit,
+                });
+            }
+        }
+        next_coordinate += 1 + n_ax;
         within(cp, &mn, [lo, hi], big_m);
         for (k, &r) in intervals.iter().enumerate() {
             within(cp, &mun[k], r, big_r);
@@ -697,6 +767,7 @@ fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
             }
         }
     }
+    let mut next_coordinate = 0;
     for (spring, s) in problem.springs.iter().enumerate() {
         let k = built.xn(problem, s.column);
         let na = s.axes_a.len();
@@ -720,6 +791,20 @@ fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
             for i in 0..n {
                 let [lo, hi] = node.anchor(problem, spring, is_b, i);
                 let c_scale = natural[first + i] / big_k;
+                // Each row is `K·(a_i − lo)/A` (or `K·(hi − a_i)/A`), at least `K_lo/A` per
+                // unit of the distance.
+                let k_lo = s.bounds.stiffness[0];
+                if k_lo > 0.0 {
+                    for upper in [false, true] {
+                        built.node_rows.push(NodeRow {
+                            coordinate: next_coordinate,
+                            upper,
+                            row: cp.rows() + usize::from(upper),
+                            per_unit: k_lo / natural[first + i],
+                        });
+                    }
+                }
+                next_coordinate += 1;
                 let mut e = coords[i].clone();
                 e.add_scaled(&k, -lo / c_scale);
                 cp.nonneg(&e);
@@ -1080,6 +1165,7 @@ fn build(
         tau_scale,
         natural,
         cw_vars,
+        node_rows: Vec::new(),
     }
 }
 

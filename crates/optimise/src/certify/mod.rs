@@ -45,7 +45,7 @@ use crate::problem::{CwPhysical, Objective, VariantProblem};
 use crate::refine::{
     FEASIBILITY_TOL, counterweight_directions, merit, project_fixed, project_radius, refine,
 };
-use crate::relaxation::RelaxationBase;
+use crate::relaxation::{EndRate, RelaxationBase};
 use crate::springs::{Spring, realize_springs};
 use crate::torque::TaskTorques;
 use coupling::coupling_projectors;
@@ -127,7 +127,7 @@ pub enum Verdict {
 pub(crate) struct Open {
     pub(crate) bound: f64,
     order: usize,
-    node: NodeBox,
+    pub(crate) node: NodeBox,
     /// The relaxed free coordinates, when the relaxation was solved.
     pub(crate) z: Option<DVector<f64>>,
     /// The relaxation's error per counterweight ([`crate::relaxation::Relaxed::cw_errors`]).
@@ -135,6 +135,9 @@ pub(crate) struct Open {
     /// Whether the bound is from an earlier search on fewer tasks (still a lower bound, but
     /// the box is solved again on these tasks before it is split).
     stale: bool,
+    /// The box's own relaxation bound and its rates per coordinate end
+    /// ([`crate::relaxation::Relaxed::reduced`]); `None` when the box was not solved.
+    pub(crate) reduced: Option<(f64, Vec<EndRate>)>,
 }
 
 /// What one search leaves for the next on the same variant: the tightened root box and every
@@ -249,6 +252,7 @@ pub(crate) fn bound_box(
             z: Some(relaxed.z),
             cw_errors: relaxed.cw_errors,
             stale: false,
+            reduced: Some((relaxed.bound, relaxed.reduced)),
         }),
         // Not solved (nor proved infeasible): the box keeps its parent's bound and is split.
         _ => Some(Open {
@@ -258,6 +262,7 @@ pub(crate) fn bound_box(
             z: None,
             cw_errors: Vec::new(),
             stale: false,
+            reduced: None,
         }),
     }
 }
@@ -683,6 +688,7 @@ pub fn branch_and_bound(
                     z: None,
                     cw_errors: Vec::new(),
                     stale: true,
+                    reduced: None,
                 });
             }
         }
@@ -828,6 +834,16 @@ pub fn branch_and_bound(
             pruned.push((current.node, current.bound));
             continue;
         }
+        let mut current = current;
+        if let (Some(d), Some((own, rates))) = (best.as_ref(), current.reduced.as_ref()) {
+            pruned.extend(reduced_cost_cuts(
+                &mut current.node,
+                *own,
+                rates,
+                d.value,
+                options.gap_tolerance,
+            ));
+        }
         let counterweights_first = !springs_block
             && current.z.as_ref().is_some_and(|z| {
                 let (_, value, _) = merit(problem, tasks, objective, z, scale);
@@ -882,6 +898,74 @@ pub fn branch_and_bound(
     }
 }
 
+/// Smallest share of a coordinate's width that a reduced-cost cut must remove to be made: each
+/// part cut off is a box that the next search on more tasks solves again, so slivers are not
+/// worth it.
+const CUT_SHARE: f64 = 0.1;
+
+/// Share of the gap tolerance below the best design's value at which the reduced-cost cuts
+/// aim: a part cut off gets this target as its bound, which closes the gap
+/// (`target ≥ value·(1 − gap)`) and is kept off the tolerance's very edge so that the certified
+/// bound does not sink to it. Measured on the palletizer at Dmax 3 (release, one run each):
+/// 17,511 boxes without the cuts; with them 16,431 at 0.9 and a cut share of 0.1, 16,820 at
+/// 0.5 and 0.1, 16,841 at 0.5 and 0.02, 16,646 at 0.99 and 0.05, 16,465 at 0.9 and 0.3 (the
+/// counts move by ±2 % with any change of a search's path); the same verdicts and every gap
+/// ≤ 1e-3 in each.
+const TARGET_SHARE: f64 = 0.9;
+
+/// Cuts from the box `node` the parts where no point of its relaxation reaches below the target
+/// `value − TARGET_SHARE·gap·|value|`, `value` the best design's (reduced-cost bound
+/// tightening). A coordinate end whose row has the dual rate `r` (see
+/// [`crate::relaxation::Relaxed::reduced`]) keeps the coordinate within `(target − b)/r` of
+/// that end, `b` the box's own bound: every point of the relaxation has an objective of at
+/// least `b + r·d` at distance `d` from the end, so the part beyond holds no design below the
+/// target. Returns the parts cut off, each with the target as its bound (they close the gap,
+/// and a next search on more tasks solves them again like every box this one leaves); the box
+/// keeps the rest. A cut must take at least [`CUT_SHARE`] of the coordinate's width.
+///
+/// The rates only weigh the rows that bound one coordinate; the box's other rows (the
+/// McCormick planes, the secants) depend on its ranges too, but not on one coordinate's
+/// distance alone, so most of the dual weight is not used: on the palletizer at Dmax 3 the
+/// cuts save about 6 % of the boxes (see [`TARGET_SHARE`]).
+pub(crate) fn reduced_cost_cuts(
+    node: &mut NodeBox,
+    own: f64,
+    rates: &[EndRate],
+    value: f64,
+    gap: f64,
+) -> Vec<(NodeBox, f64)> {
+    let target = value - TARGET_SHARE * gap * value.abs();
+    if target.partial_cmp(&own) != Some(std::cmp::Ordering::Greater) {
+        return Vec::new();
+    }
+    let mut cut = Vec::new();
+    for &EndRate {
+        coordinate: k,
+        upper,
+        rate,
+    } in rates
+    {
+        // A little farther than the exact reach: the part cut off is then certainly above the
+        // target, whatever the rounding of this quotient.
+        let reach = (target - own) / rate * (1.0 + 1e-9);
+        let [lo, hi] = node.ranges[k];
+        let width = hi - lo;
+        if !(reach.is_finite() && width > 0.0 && reach < (1.0 - CUT_SHARE) * width) {
+            continue;
+        }
+        let mut far = node.clone();
+        if upper {
+            far.ranges[k][1] = hi - reach;
+            node.ranges[k][0] = hi - reach;
+        } else {
+            far.ranges[k][0] = lo + reach;
+            node.ranges[k][1] = lo + reach;
+        }
+        cut.push((far, target));
+    }
+    cut
+}
+
 /// The order of the `n`-th child box of a split made when the orders given so far end at
 /// `order` (each split takes two: the loop adds 2 after it). Every child is newer than every
 /// box before the split, so that among tied bounds the search dives into the boxes it just
@@ -926,7 +1010,100 @@ pub fn bounds_in_words(problem: &VariantProblem) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{KeptRanges, NodeBox, child_order};
+    use super::{CUT_SHARE, KeptRanges, NodeBox, TARGET_SHARE, child_order, reduced_cost_cuts};
+    use crate::relaxation::EndRate;
+
+    fn end(coordinate: usize, upper: bool, rate: f64) -> EndRate {
+        EndRate {
+            coordinate,
+            upper,
+            rate,
+        }
+    }
+
+    /// By hand: a box [0, 1] × [−2, 2] with bound 10, the best design at 10.02 and a gap of
+    /// 1e-3 aim at 10.02 − 0.9·1e-3·10.02 = 10.010982. A rate of 100 per unit at coordinate 0's
+    /// lower end keeps it within 0.010982/100 = 1.0982e-4 of 0; a rate of 1 at coordinate 1's
+    /// upper end keeps it within 0.010982 of 2; a rate of 0.0122 at coordinate 0's upper end
+    /// keeps it within 0.010982/0.0122 = 0.9 of 1.0982e-4, more than the width left after the
+    /// first cut, so it cuts nothing. (The reach is rounded outwards by 1e-9 relative.)
+    #[test]
+    fn reduced_cost_cuts_keep_each_coordinate_within_its_reach() {
+        assert_eq!(TARGET_SHARE, 0.9);
+        let target = 10.02 - 0.9 * 1e-3 * 10.02;
+        let mut node = NodeBox {
+            ranges: vec![[0.0, 1.0], [-2.0, 2.0]],
+        };
+        let rates = [
+            end(0, false, 100.0),
+            end(1, true, 1.0),
+            end(0, true, 0.0122),
+        ];
+        let cut = reduced_cost_cuts(&mut node, 10.0, &rates, 10.02, 1e-3);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-8 * (1.0 + b.abs());
+        assert_eq!(cut.len(), 2, "{cut:?}");
+        let reach0 = (target - 10.0) / 100.0;
+        let reach1 = target - 10.0;
+        assert!(close(reach0, 1.0982e-4) && close(reach1, 0.010982));
+        // The box keeps [0, reach0] × [2 − reach1, 2]; the parts cut off are the rest of
+        // coordinate 0, then the rest of coordinate 1 within the kept coordinate 0.
+        let kept = &node.ranges;
+        assert!(kept[0][0] == 0.0 && close(kept[0][1], reach0), "{kept:?}");
+        assert!(
+            close(kept[1][0], 2.0 - reach1) && kept[1][1] == 2.0,
+            "{kept:?}"
+        );
+        let (first, second) = (&cut[0], &cut[1]);
+        assert!(close(first.0.ranges[0][0], reach0) && first.0.ranges[0][1] == 1.0);
+        assert_eq!(first.0.ranges[1], [-2.0, 2.0]);
+        assert!(close(second.0.ranges[0][1], reach0) && second.0.ranges[0][0] == 0.0);
+        assert!(second.0.ranges[1][0] == -2.0 && close(second.0.ranges[1][1], 2.0 - reach1));
+        // Every part cut off holds the target as its bound, which closes the gap.
+        for (_, bound) in &cut {
+            assert!(close(*bound, target));
+            assert!(10.02 - bound <= 1e-3 * 10.02);
+        }
+        // The reach is rounded outwards: the cut never comes nearer the end than the exact
+        // reach.
+        assert!(kept[0][1] >= reach0 && 2.0 - kept[1][0] >= reach1);
+    }
+
+    /// No cut where the box's bound already reaches the target, or where the reach leaves
+    /// more than `1 − CUT_SHARE` of the width.
+    #[test]
+    fn reduced_cost_cuts_need_a_box_below_the_target_and_a_real_cut() {
+        let target = 10.02 - 0.9 * 1e-3 * 10.02;
+        let unit = || NodeBox {
+            ranges: vec![[0.0, 1.0]],
+        };
+        let rates = [end(0, false, 100.0)];
+        assert!(reduced_cost_cuts(&mut unit(), target + 1e-9, &rates, 10.02, 1e-3).is_empty());
+        assert_eq!(
+            reduced_cost_cuts(&mut unit(), 10.0, &rates, 10.02, 1e-3).len(),
+            1
+        );
+        // Reach 0.010982 / r against a width of 1: cut at r just above 0.010982/(1 − share),
+        // not just below.
+        let edge = (target - 10.0) / (1.0 - CUT_SHARE);
+        let cuts = reduced_cost_cuts(
+            &mut unit(),
+            10.0,
+            &[end(0, false, edge * 1.001)],
+            10.02,
+            1e-3,
+        );
+        assert_eq!(cuts.len(), 1);
+        let mut sliver = unit();
+        let none = reduced_cost_cuts(
+            &mut sliver,
+            10.0,
+            &[end(0, false, edge * 0.999)],
+            10.02,
+            1e-3,
+        );
+        assert!(none.is_empty());
+        assert_eq!(sliver.ranges, vec![[0.0, 1.0]]);
+    }
 
     /// A range is solved again exactly when its column was not solved on this box: counted
     /// by hand over a sequence of requests on two boxes and three columns.

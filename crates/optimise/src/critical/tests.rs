@@ -1485,3 +1485,168 @@ fn siblings_offer_only_designs_that_still_stand() {
         shared.iter().map(|s| &s.1.from).collect::<Vec<_>>()
     );
 }
+
+/// Checks the reduced-cost cuts of `problem`'s first box on `tasks` by a second method, the
+/// relaxation solved on each part cut off: each coordinate in turn (anchor components, masses,
+/// first moments) is held away from the relaxed optimum (the quarter of the way to its farther
+/// end nearest the optimum left out), so that the box's optimum sits on that bound and the
+/// dual weighs its row; where the rate lifts the bound by at least 1e-4 over half the width,
+/// the best design's value is set so that the cut takes half of that width, and the part cut
+/// off must be empty or bound at least the target (to the solver's margin, 1e-5 relative).
+/// Returns per end checked the coordinate, the side, the part's bound over the target less 1
+/// (infinite when empty) and whether the part a rate ten times too large would cut off reaches
+/// below the target (the control that the check can fail).
+fn cuts_checked_by_the_parts_relaxations(
+    problem: &VariantProblem,
+    tasks: &[Arc<TaskTorques>],
+    options: &OptimiseOptions,
+) -> Vec<(crate::certify::node::Coordinate, bool, f64, bool)> {
+    use crate::certify::node::{Coordinate, coordinates};
+    let branch = options.branch_options();
+    let base = crate::relaxation::RelaxationBase::new(problem, tasks, options.objective);
+    let bases = crate::certify::Bases {
+        first: &base,
+        fallback: None,
+    };
+    let solve = |node: crate::certify::node::NodeBox| {
+        crate::certify::bound_box(
+            problem,
+            &bases,
+            &mut Vec::new(),
+            &branch,
+            node,
+            f64::NEG_INFINITY,
+            0,
+        )
+        .map_or(f64::INFINITY, |o| o.bound)
+    };
+    let root = crate::certify::root_box(problem, &branch).unwrap();
+    let first = crate::certify::bound_box(
+        problem,
+        &bases,
+        &mut Vec::new(),
+        &branch,
+        root.clone(),
+        f64::NEG_INFINITY,
+        0,
+    )
+    .expect("the first box holds designs");
+    let x = problem.lifted(first.z.as_ref().expect("solved"));
+    let gap = branch.gap_tolerance;
+    let mut checked = Vec::new();
+    for (k, coordinate) in coordinates(problem).into_iter().enumerate() {
+        let optimum = match coordinate {
+            Coordinate::AnchorA { spring, i } => {
+                let c = problem.springs[spring].column;
+                x[c + 1 + i] / x[c]
+            }
+            Coordinate::AnchorB { spring, l } => {
+                let s = &problem.springs[spring];
+                x[s.column + 1 + s.axes_a.len() + l] / x[s.column]
+            }
+            Coordinate::Mass { cw } => x[problem.counterweights[cw].column],
+            Coordinate::Moment { cw, k } => x[problem.counterweights[cw].column + 1 + k],
+        };
+        let [lo, hi] = root.ranges[k];
+        if !(lo < optimum && optimum < hi) {
+            continue;
+        }
+        let mut held = root.clone();
+        held.ranges[k] = if hi - optimum > optimum - lo {
+            [optimum + 0.25 * (hi - optimum), hi]
+        } else {
+            [lo, optimum - 0.25 * (optimum - lo)]
+        };
+        // (A box held away may hold nothing, or be left unsolved: nothing to check there.)
+        let Some((own, rates)) = crate::certify::bound_box(
+            problem,
+            &bases,
+            &mut Vec::new(),
+            &branch,
+            held.clone(),
+            f64::NEG_INFINITY,
+            0,
+        )
+        .and_then(|o| o.reduced) else {
+            continue;
+        };
+        for &crate::relaxation::EndRate { upper, rate, .. } in
+            rates.iter().filter(|r| r.coordinate == k)
+        {
+            let [lo, hi] = held.ranges[k];
+            let target = own + rate * 0.5 * (hi - lo);
+            if target - own < 1e-4 * own {
+                continue;
+            }
+            // target = value − 0.9·gap·value
+            let value = target / (1.0 - 0.9 * gap);
+            let cut_at = |rate: f64| {
+                let cut = crate::certify::reduced_cost_cuts(
+                    &mut held.clone(),
+                    own,
+                    &[crate::relaxation::EndRate {
+                        coordinate: k,
+                        upper,
+                        rate,
+                    }],
+                    value,
+                    gap,
+                );
+                assert_eq!(cut.len(), 1, "coordinate {k} ({upper}): a cut is expected");
+                let (far, bound) = cut.into_iter().next().unwrap();
+                assert!((bound - target).abs() <= 1e-9 * target.abs());
+                far
+            };
+            let far = cut_at(rate);
+            let far_bound = solve(far.clone());
+            assert!(
+                far_bound >= target * (1.0 - 1e-5),
+                "coordinate {k} ({upper}): the part cut off {:?} bounds {far_bound} < {target}",
+                far.ranges[k],
+            );
+            let wrong = solve(cut_at(10.0 * rate));
+            checked.push((
+                coordinate,
+                upper,
+                far_bound / target - 1.0,
+                wrong < target * (1.0 - 1e-5),
+            ));
+        }
+    }
+    checked
+}
+
+/// The reduced-cost cuts (`certify::reduced_cost_cuts`) rest on weak duality over a box's
+/// relaxation: a part they cut off holds no relaxed point below its target (checked as
+/// [`cuts_checked_by_the_parts_relaxations`] says). On the pendulum hybrid the rows of the
+/// counterweight's mass and two moments carry the weight (its anchors' never do: the stiffness
+/// makes up for them), and a rate ten times too large cuts into points below the target at
+/// each; on the palletizer's m4 + K32 + K73 (on its first working set) K73's anchor rows do
+/// too, their parts cut off bound well above the target or hold nothing.
+#[test]
+fn a_part_cut_off_by_its_dual_rate_holds_no_relaxed_point_below_its_target() {
+    use crate::certify::node::Coordinate;
+    let anchor =
+        |c: &Coordinate| matches!(c, Coordinate::AnchorA { .. } | Coordinate::AnchorB { .. });
+    let (_, problem, tasks, options) = pendulum_hybrid_search();
+    let checked = cuts_checked_by_the_parts_relaxations(&problem, &tasks, &options);
+    assert!(
+        checked.len() >= 3 && checked.iter().all(|c| !anchor(&c.0) && c.3),
+        "{checked:?}"
+    );
+    let model = palletizer_dmax3();
+    let ctx = Context::new(&model, None).unwrap();
+    let run = new_run(
+        &ctx,
+        &balanced_variant(&model, &["m4", "K32", "K73"]),
+        &options,
+    );
+    let problem = run.problem.unwrap();
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+    let checked = cuts_checked_by_the_parts_relaxations(&problem, &tasks, &options);
+    assert!(
+        checked.iter().filter(|c| anchor(&c.0)).count() >= 2
+            && checked.iter().any(|c| !anchor(&c.0) && c.3),
+        "{checked:?}"
+    );
+}
