@@ -93,39 +93,29 @@ pub(crate) fn squared_norm_quartic(group: &[u32], components: [[&[f64]; 3]; 3], 
 pub(crate) const FLOOR_MARGIN: f64 = 1e-12;
 
 /// The flat indices `row · cols + column` of the reaction rows whose peak over the sub-task can
-/// reach `floor`: per row, `max_k Σ_i |c_i| D^i` over the samples, with `D` the largest `|Δ|`
-/// of the tasks, bounds every task's `|F|²` or `|M|²` (the computed quartic exceeds its exact
+/// reach `floor`, from each row's `bound`: `max_k Σ_i |c_i| D^i` over the samples, with `D` the
+/// largest `|Δ|` of the tasks ([`quartic_bound_max`], summed as each sample's quartics are
+/// formed), which bounds every task's `|F|²` or `|M|²` (the computed quartic exceeds its exact
 /// value by far less than [`FLOOR_MARGIN`]).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn reaction_rows_above(
-    coefficients: &[f64],
-    stride: usize,
-    offset: usize,
-    rq: usize,
-    ns: usize,
-    tasks: &[(bool, f64)],
-    floor: &[f64],
-    bound: &mut Vec<f64>,
-) -> Vec<usize> {
-    let d = tasks
-        .iter()
-        .fold(0.0f64, |m, &(_, delta)| m.max(delta.abs()));
-    let bound = zeroed(bound, rq);
-    for k in 0..ns {
-        let base = &coefficients[k * stride + offset..k * stride + offset + 5 * rq];
-        quartic_bound_max(base, rq, d, bound);
-    }
-    (0..rq)
+pub(crate) fn reaction_rows_above(bound: &[f64], floor: &[f64]) -> Vec<usize> {
+    (0..bound.len())
         .filter(|&i| bound[i] * (1.0 + FLOOR_MARGIN) >= floor[i])
         .collect()
 }
 
+/// The largest `|Δ|` of a sub-task's `(reversed, Δ)` tasks: the `D` of [`quartic_bound_max`].
+pub(crate) fn largest_step(tasks: &[(bool, f64)]) -> f64 {
+    tasks
+        .iter()
+        .fold(0.0f64, |m, &(_, delta)| m.max(delta.abs()))
+}
+
 crate::simd::multiversion! {
-/// `bound[i] = max(bound[i], Σ_p |c_p[i]| d^p)` for the five coefficient arrays of `base`.
-pub(crate) fn quartic_bound_max(base: &[f64], rq: usize, d: f64, bound: &mut [f64]) {
-    let [c0, c1, c2, c3, c4] = quartic_arrays(base, rq);
-    let bound = &mut bound[..rq];
-    for i in 0..rq {
+/// `bound[i] = max(bound[i], Σ_p |c_p[i]| d^p)` for the five coefficient arrays `c`.
+pub(crate) fn quartic_bound_max(c: [&[f64]; 5], d: f64, bound: &mut [f64]) {
+    let n = bound.len();
+    let [c0, c1, c2, c3, c4] = c.map(|x| &x[..n]);
+    for i in 0..n {
         let b = c4[i]
             .abs()
             .mul_add(d, c3[i].abs())

@@ -262,6 +262,24 @@ pub(crate) fn evaluate_cyclic(
         .then(|| InertiaSums::new(&crate::params::model_body_params(ev.model), &groups));
     let one_sub_task = |work: &mut Work, st: usize, floor: Option<&[f64]>| -> SubTaskOutcome {
         let (s1, s2) = st_pairs[st];
+        // Tasks whose Δ agree to 1e-12 of the cyclic span share one evaluation (grid
+        // differences such as θ(3) − θ(1) and θ(4) − θ(2) differ in the last bits); the
+        // first task of a group (lowest index) provides its Δ.
+        let mut index: HashMap<(bool, i64), usize> = HashMap::new();
+        let mut unique: Vec<(bool, f64)> = Vec::new();
+        let slot: Vec<usize> = users[st]
+            .iter()
+            .map(|&(_, rev, delta)| {
+                let key = (rev, (delta / delta_quantum).round() as i64);
+                *index.entry(key).or_insert_with(|| {
+                    unique.push((rev, delta));
+                    unique.len() - 1
+                })
+            })
+            .collect();
+        // With floors, the reaction rows' bounds over the tasks' largest step are summed as the
+        // quartics are formed (see `reaction_rows_above`).
+        let reach = (floor.is_some() && nj > 0).then(|| largest_step(&unique));
         let data = match &sub_q[s1] {
             Err(reason) => Err((0, reason.clone())),
             Ok(q0) => sub_task(
@@ -279,6 +297,7 @@ pub(crate) fn evaluate_cyclic(
                 combination == Combination::Substitution,
                 with_reactions,
                 per_sample_stride,
+                reach,
                 work,
             ),
         };
@@ -299,21 +318,6 @@ pub(crate) fn evaluate_cyclic(
                     .collect());
             }
         }
-        // Tasks whose Δ agree to 1e-12 of the cyclic span share one evaluation (grid
-        // differences such as θ(3) − θ(1) and θ(4) − θ(2) differ in the last bits); the
-        // first task of a group (lowest index) provides its Δ.
-        let mut index: HashMap<(bool, i64), usize> = HashMap::new();
-        let mut unique: Vec<(bool, f64)> = Vec::new();
-        let slot: Vec<usize> = users[st]
-            .iter()
-            .map(|&(_, rev, delta)| {
-                let key = (rev, (delta / delta_quantum).round() as i64);
-                *index.entry(key).or_insert_with(|| {
-                    unique.push((rev, delta));
-                    unique.len() - 1
-                })
-            })
-            .collect();
         let rows = task_stats(
             &work.coefficients,
             per_sample_stride,
@@ -424,18 +428,10 @@ fn task_stats(
     let nt = tasks.len();
     let tq = na * cols;
     let rq = 2 * nj * cols;
-    // Reaction rows that may reach their floor (see `reaction_rows_above`); `None`: every row.
+    // Reaction rows that may reach their floor (see `reaction_rows_above`, the bounds formed
+    // by `sub_task` whenever there are floors); `None`: every row.
     let active = match floor {
-        Some(floor) if nj > 0 => Some(reaction_rows_above(
-            coefficients,
-            stride,
-            3 * tq,
-            rq,
-            ns,
-            tasks,
-            floor,
-            &mut scratch.bound,
-        )),
+        Some(floor) if nj > 0 => Some(reaction_rows_above(&scratch.bound[..rq], floor)),
         _ => None,
     };
     let sum_sq = zeroed(&mut scratch.sum_sq, nt * tq);
@@ -533,7 +529,9 @@ fn task_stats(
 }
 
 /// Evaluates one sub-task at `Δ ∈ {0, 1, −1}` per sample and stores the coefficients in
-/// `work.coefficients`.
+/// `work.coefficients`; with `reach` (the tasks' largest `|Δ|`), also each reaction row's bound
+/// over the samples in `work.stats.bound` ([`quartic_bound_max`], on each slot's quartics
+/// while they are in cache).
 #[allow(clippy::too_many_arguments)]
 fn sub_task(
     ev: &Evaluator,
@@ -550,6 +548,7 @@ fn sub_task(
     substitute: bool,
     with_reactions: bool,
     stride: usize,
+    reach: Option<f64>,
     work: &mut Work,
 ) -> Result<(), (usize, FailureReason)> {
     let mech = &ev.mech;
@@ -595,6 +594,10 @@ fn sub_task(
     if with_reactions {
         work.b.resize(rows * solved, 0.0);
         work.out.resize(6 * nj * solved, 0.0);
+    }
+    let reach = reach.filter(|_| with_reactions);
+    if reach.is_some() {
+        zeroed(&mut work.stats.bound, rq);
     }
     for k in 0..ns {
         let t = sample_time(k, ns, duration);
@@ -870,9 +873,22 @@ fn sub_task(
                             &mut q1[slot.clone()],
                             &mut q2[slot.clone()],
                             &mut q3[slot.clone()],
-                            &mut q4[slot],
+                            &mut q4[slot.clone()],
                         ],
                     );
+                    if let Some(d) = reach {
+                        quartic_bound_max(
+                            [
+                                &q0[slot.clone()],
+                                &q1[slot.clone()],
+                                &q2[slot.clone()],
+                                &q3[slot.clone()],
+                                &q4[slot.clone()],
+                            ],
+                            d,
+                            &mut work.stats.bound[slot],
+                        );
+                    }
                 }
             }
         }
