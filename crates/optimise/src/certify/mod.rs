@@ -127,7 +127,7 @@ pub enum Verdict {
 pub(crate) struct Open {
     pub(crate) bound: f64,
     order: usize,
-    pub(crate) node: NodeBox,
+    node: NodeBox,
     /// The relaxed free coordinates, when the relaxation was solved.
     pub(crate) z: Option<DVector<f64>>,
     /// The relaxation's error per counterweight ([`crate::relaxation::Relaxed::cw_errors`]).
