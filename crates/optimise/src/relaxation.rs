@@ -31,7 +31,7 @@ use std::sync::Arc;
 use counterpoise_dynamics::params::BODY_PARAMS;
 use nalgebra::{DMatrix, DVector};
 
-use crate::certify::node::{NodeBox, square_over_linear_planes};
+use crate::certify::node::{Coordinate, NodeBox, square_over_linear_planes};
 use crate::clarabel_map::{Affine, ConicProblem, ConicSolution, ConicStatus};
 use crate::problem::{Objective, VariantProblem};
 use crate::torque::TaskTorques;
@@ -673,13 +673,13 @@ pub fn lagrange_terms(s: &crate::slots::SpringSlot) -> Vec<Vec<(usize, f64)>> {
 /// Appends a node's rows (see [`solve_relaxation_in`]).
 fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
     let natural = built.natural.clone();
-    // The branching coordinates' order (`certify::node::coordinates`): every spring's anchor
-    // components, then every counterweight's mass and first moments.
-    let mut next_coordinate: usize = problem
-        .springs
+    // The branching coordinates in `certify::node::coordinates` order: every spring's anchor
+    // components, then every counterweight's mass and first moments (the rows below follow it).
+    let coordinates = crate::certify::node::coordinates(problem);
+    let mut next_coordinate = coordinates
         .iter()
-        .map(|s| s.axes_a.len() + s.axes_b.len())
-        .sum();
+        .position(|c| matches!(c, Coordinate::Mass { .. }))
+        .unwrap_or(coordinates.len());
     for (cw, c) in problem.counterweights.iter().enumerate() {
         let vars = built.cw_vars[cw].clone();
         let big_m = natural[c.column];
