@@ -1622,7 +1622,8 @@ fn cuts_checked_by_the_parts_relaxations(
 /// counterweight's mass and two moments carry the weight (its anchors' never do: the stiffness
 /// makes up for them), and a rate ten times too large cuts into points below the target at
 /// each; on the palletizer's m4 + K32 + K73 (on its first working set) K73's anchor rows do
-/// too, their parts cut off bound well above the target or hold nothing.
+/// too, their parts cut off bound well above the target or hold nothing; on m4 + m5 + K43 the
+/// second counterweight's rows (numbered after the first's coordinates) are checked too.
 #[test]
 fn a_part_cut_off_by_its_dual_rate_holds_no_relaxed_point_below_its_target() {
     use crate::certify::node::Coordinate;
@@ -1647,6 +1648,22 @@ fn a_part_cut_off_by_its_dual_rate_holds_no_relaxed_point_below_its_target() {
     assert!(
         checked.iter().filter(|c| anchor(&c.0)).count() >= 2
             && checked.iter().any(|c| !anchor(&c.0) && c.3),
+        "{checked:?}"
+    );
+    // Two counterweights: the second one's rows follow the first one's coordinates.
+    let run = new_run(
+        &ctx,
+        &balanced_variant(&model, &["m4", "m5", "K43"]),
+        &options,
+    );
+    let problem = run.problem.unwrap();
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+    let checked = cuts_checked_by_the_parts_relaxations(&problem, &tasks, &options);
+    assert!(
+        checked.iter().any(|c| matches!(
+            c.0,
+            Coordinate::Mass { cw: 1 } | Coordinate::Moment { cw: 1, .. }
+        )),
         "{checked:?}"
     );
 }
