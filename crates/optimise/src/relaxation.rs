@@ -673,13 +673,14 @@ pub fn lagrange_terms(s: &crate::slots::SpringSlot) -> Vec<Vec<(usize, f64)>> {
 /// Appends a node's rows (see [`solve_relaxation_in`]).
 fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
     let natural = built.natural.clone();
-    // The branching coordinates in `certify::node::coordinates` order: every spring's anchor
-    // components, then every counterweight's mass and first moments (the rows below follow it).
+    // Each bound row is recorded with its coordinate's index in `certify::node::coordinates`.
     let coordinates = crate::certify::node::coordinates(problem);
-    let mut next_coordinate = coordinates
-        .iter()
-        .position(|c| matches!(c, Coordinate::Mass { .. }))
-        .unwrap_or(coordinates.len());
+    let index_of = |c: Coordinate| {
+        coordinates
+            .iter()
+            .position(|&x| x == c)
+            .expect("every bound row's coordinate is a branching coordinate")
+    };
     for (cw, c) in problem.counterweights.iter().enumerate() {
         let vars = built.cw_vars[cw].clone();
         let big_m = natural[c.column];
@@ -699,20 +700,19 @@ fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
         let [lo, hi] = node.mass(problem, cw);
         let intervals: Vec<[f64; 2]> = (0..n_ax).map(|k| node.moment(problem, cw, k)).collect();
         // `within` adds the lower side's row, then the upper's.
-        for (k, per_unit) in std::iter::once(1.0 / big_m)
-            .chain((0..n_ax).map(|_| 1.0 / big_r))
+        for (k, (coordinate, per_unit)) in std::iter::once((Coordinate::Mass { cw }, 1.0 / big_m))
+            .chain((0..n_ax).map(|k| (Coordinate::Moment { cw, k }, 1.0 / big_r)))
             .enumerate()
         {
             for upper in [false, true] {
                 built.node_rows.push(NodeRow {
-                    coordinate: next_coordinate + k,
+                    coordinate: index_of(coordinate),
                     upper,
                     row: cp.rows() + 2 * k + usize::from(upper),
                     per_unit,
                 });
             }
         }
-        next_coordinate += 1 + n_ax;
         within(cp, &mn, [lo, hi], big_m);
         for (k, &r) in intervals.iter().enumerate() {
             within(cp, &mun[k], r, big_r);
@@ -767,7 +767,6 @@ fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
             }
         }
     }
-    let mut next_coordinate = 0;
     for (spring, s) in problem.springs.iter().enumerate() {
         let k = built.xn(problem, s.column);
         let na = s.axes_a.len();
@@ -795,16 +794,20 @@ fn add_node_rows(problem: &VariantProblem, built: &mut Built, node: &NodeBox) {
                 // unit of the distance.
                 let k_lo = s.bounds.stiffness[0];
                 if k_lo > 0.0 {
+                    let coordinate = index_of(if is_b {
+                        Coordinate::AnchorB { spring, l: i }
+                    } else {
+                        Coordinate::AnchorA { spring, i }
+                    });
                     for upper in [false, true] {
                         built.node_rows.push(NodeRow {
-                            coordinate: next_coordinate,
+                            coordinate,
                             upper,
                             row: cp.rows() + usize::from(upper),
                             per_unit: k_lo / natural[first + i],
                         });
                     }
                 }
-                next_coordinate += 1;
                 let mut e = coords[i].clone();
                 e.add_scaled(&k, -lo / c_scale);
                 cp.nonneg(&e);

@@ -1637,28 +1637,20 @@ fn a_part_cut_off_by_its_dual_rate_holds_no_relaxed_point_below_its_target() {
     );
     let model = palletizer_dmax3();
     let ctx = Context::new(&model, None).unwrap();
-    let run = new_run(
-        &ctx,
-        &balanced_variant(&model, &["m4", "K32", "K73"]),
-        &options,
-    );
-    let problem = run.problem.unwrap();
-    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
-    let checked = cuts_checked_by_the_parts_relaxations(&problem, &tasks, &options);
+    let checked_on = |labels: &[&str]| {
+        let run = new_run(&ctx, &balanced_variant(&model, labels), &options);
+        let problem = run.problem.unwrap();
+        let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+        cuts_checked_by_the_parts_relaxations(&problem, &tasks, &options)
+    };
+    let checked = checked_on(&["m4", "K32", "K73"]);
     assert!(
         checked.iter().filter(|c| anchor(&c.0)).count() >= 2
             && checked.iter().any(|c| !anchor(&c.0) && c.3),
         "{checked:?}"
     );
     // Two counterweights: the second one's rows follow the first one's coordinates.
-    let run = new_run(
-        &ctx,
-        &balanced_variant(&model, &["m4", "m5", "K43"]),
-        &options,
-    );
-    let problem = run.problem.unwrap();
-    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
-    let checked = cuts_checked_by_the_parts_relaxations(&problem, &tasks, &options);
+    let checked = checked_on(&["m4", "m5", "K43"]);
     assert!(
         checked.iter().any(|c| matches!(
             c.0,
