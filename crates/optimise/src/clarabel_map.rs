@@ -254,6 +254,13 @@ impl ConicProblem {
         self.rhs.len()
     }
 
+    /// The value of row `i`'s expression `e(x)` (the cone slack `b − A x`) at `x`.
+    #[cfg(test)]
+    pub(crate) fn row_value(&self, i: usize, x: &[f64]) -> f64 {
+        let terms = &self.terms[self.row_start[i]..self.row_start[i + 1]];
+        self.rhs[i] - terms.iter().map(|&(j, d)| d * x[j]).sum::<f64>()
+    }
+
     /// Solves with clarabel (quiet, deterministic); when clarabel stops short of `Solved`
     /// without proving infeasibility, retries with more iterations and a more cautious step,
     /// then with a stronger regularization and more equilibration and optimality tolerances

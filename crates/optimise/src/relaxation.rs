@@ -466,6 +466,36 @@ impl RelaxationBase {
         built.solve(problem, max_iter, active)
     }
 
+    /// Each row of `node`'s relaxation that bounds one coordinate: its coordinate (in
+    /// [`crate::certify::node::coordinates`] order), its side, its `per_unit` and its value at
+    /// the free point `z` (the conic variables other than `z`'s at 0).
+    #[cfg(test)]
+    pub(crate) fn node_row_values(
+        &self,
+        problem: &VariantProblem,
+        node: &NodeBox,
+        z: &DVector<f64>,
+    ) -> Vec<(usize, bool, f64, f64)> {
+        let mut built = self.0.clone();
+        add_node_rows(problem, &mut built, node);
+        let mut v = vec![0.0; built.cp.variables];
+        for (k, (&j, &s)) in built.z.iter().zip(&built.dz).enumerate() {
+            v[j] = z[k] / s;
+        }
+        built
+            .node_rows
+            .iter()
+            .map(|r| {
+                (
+                    r.coordinate,
+                    r.upper,
+                    r.per_unit,
+                    built.cp.row_value(r.row, &v),
+                )
+            })
+            .collect()
+    }
+
     /// Rows of the conic problem (without a node's rows or peak rows).
     pub fn rows(&self) -> usize {
         self.0.cp.rows()

@@ -1659,3 +1659,72 @@ fn a_part_cut_off_by_its_dual_rate_holds_no_relaxed_point_below_its_target() {
         "{checked:?}"
     );
 }
+
+/// Every row a box records as bounding one coordinate is the row it says, by its value: for
+/// an anchor `K·(a_i − lo)/A = (K/K_lo)·per_unit·(a_i − lo)` (and `hi − a_i` for the upper
+/// side), for a mass or first moment `per_unit·(v − lo)` (and `hi − v`), at points of the
+/// relaxation's family where `K`, `a_i`, `m` and `μ_k` are read back from the lifted vector.
+/// The reduced-cost cuts weigh each row's dual by these values, so a row taken from another
+/// place (an off-by-one index, a counterweight's rows numbered from the wrong coordinate)
+/// would cut by another row's rate.
+#[test]
+fn each_recorded_bound_row_measures_its_coordinates_distance_from_its_end() {
+    use crate::certify::node::{Coordinate, coordinates};
+    let model = palletizer_dmax3();
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let branch = options.branch_options();
+    for labels in [&["m4", "m5", "K43"][..], &["m4", "K32", "K73"][..]] {
+        let run = new_run(&ctx, &balanced_variant(&model, labels), &options);
+        let problem = run.problem.unwrap();
+        let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+        let base = crate::relaxation::RelaxationBase::new(&problem, &tasks, options.objective);
+        let root = crate::certify::root_box(&problem, &branch).unwrap();
+        let relaxed = base.solve(&problem, Some(&root), 200, &mut Vec::new());
+        let coords = coordinates(&problem);
+        // The relaxed optimum, and points moved from it along each free direction.
+        let mut points = vec![relaxed.z.clone()];
+        for k in 0..problem.dim() {
+            let mut z = relaxed.z.clone();
+            z[k] += 0.01 * (1.0 + z[k].abs()) * if k % 2 == 0 { 1.0 } else { -1.0 };
+            points.push(z);
+        }
+        for z in &points {
+            let x = problem.lifted(z);
+            let rows = base.node_row_values(&problem, &root, z);
+            let mut seen = vec![[false; 2]; coords.len()];
+            for &(k, upper, per_unit, value) in &rows {
+                seen[k][usize::from(upper)] = true;
+                let [lo, hi] = root.ranges[k];
+                let (scale, v) = match coords[k] {
+                    Coordinate::AnchorA { spring, i } => {
+                        let s = &problem.springs[spring];
+                        let kk = x[s.column];
+                        (kk / s.bounds.stiffness[0], x[s.column + 1 + i] / kk)
+                    }
+                    Coordinate::AnchorB { spring, l } => {
+                        let s = &problem.springs[spring];
+                        let kk = x[s.column];
+                        let na = s.axes_a.len();
+                        (kk / s.bounds.stiffness[0], x[s.column + 1 + na + l] / kk)
+                    }
+                    Coordinate::Mass { cw } => (1.0, x[problem.counterweights[cw].column]),
+                    Coordinate::Moment { cw, k } => {
+                        (1.0, x[problem.counterweights[cw].column + 1 + k])
+                    }
+                };
+                let distance = if upper { hi - v } else { v - lo };
+                let expected = scale * per_unit * distance;
+                let size = scale * per_unit * (hi - lo).abs().max(v.abs()).max(1e-3);
+                assert!(
+                    (value - expected).abs() <= 1e-9 * size,
+                    "{labels:?}: {:?} {} row: {value} against {expected}",
+                    coords[k],
+                    if upper { "upper" } else { "lower" }
+                );
+            }
+            // Both sides of every coordinate (the palletizer's springs have K_lo > 0).
+            assert!(seen.iter().all(|s| s[0] && s[1]), "{labels:?}: {seen:?}");
+        }
+    }
+}
