@@ -1709,8 +1709,8 @@ fn each_recorded_bound_row_measures_its_coordinates_distance_from_its_end() {
                         (kk / s.bounds.stiffness[0], x[s.column + 1 + na + l] / kk)
                     }
                     Coordinate::Mass { cw } => (1.0, x[problem.counterweights[cw].column]),
-                    Coordinate::Moment { cw, k } => {
-                        (1.0, x[problem.counterweights[cw].column + 1 + k])
+                    Coordinate::Moment { cw, k: axis } => {
+                        (1.0, x[problem.counterweights[cw].column + 1 + axis])
                     }
                 };
                 let distance = if upper { hi - v } else { v - lo };
