@@ -1486,6 +1486,41 @@ fn siblings_offer_only_designs_that_still_stand() {
     );
 }
 
+/// The value of branching coordinate `c` at the lifted point `x`: an anchor component
+/// `(K·a_i)/K`, a mass, a first-moment component.
+fn coordinate_value(
+    problem: &VariantProblem,
+    c: crate::certify::node::Coordinate,
+    x: &DVector<f64>,
+) -> f64 {
+    use crate::certify::node::Coordinate;
+    match c {
+        Coordinate::AnchorA { spring, i } => {
+            let s = &problem.springs[spring];
+            x[s.column + 1 + i] / x[s.column]
+        }
+        Coordinate::AnchorB { spring, l } => {
+            let s = &problem.springs[spring];
+            x[s.column + 1 + s.axes_a.len() + l] / x[s.column]
+        }
+        Coordinate::Mass { cw } => x[problem.counterweights[cw].column],
+        Coordinate::Moment { cw, k } => x[problem.counterweights[cw].column + 1 + k],
+    }
+}
+
+/// The problem of the palletizer variant whose element labels are `labels` (before the
+/// critical-task loop) and its working set's task torques.
+fn problem_and_tasks(
+    ctx: &Context,
+    model: &Model,
+    labels: &[&str],
+    options: &OptimiseOptions,
+) -> (VariantProblem, Vec<Arc<TaskTorques>>) {
+    let run = new_run(ctx, &balanced_variant(model, labels), options);
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+    (run.problem.unwrap(), tasks)
+}
+
 /// Checks the reduced-cost cuts of `problem`'s first box on `tasks` by a second method, the
 /// relaxation solved on each part cut off: each coordinate in turn (anchor components, masses,
 /// first moments) is held away from the relaxed optimum (the quarter of the way to its farther
@@ -1501,7 +1536,7 @@ fn cuts_checked_by_the_parts_relaxations(
     tasks: &[Arc<TaskTorques>],
     options: &OptimiseOptions,
 ) -> Vec<(crate::certify::node::Coordinate, bool, f64, bool)> {
-    use crate::certify::node::{Coordinate, coordinates};
+    use crate::certify::node::coordinates;
     let branch = options.branch_options();
     let base = crate::relaxation::RelaxationBase::new(problem, tasks, options.objective);
     let bases = crate::certify::Bases {
@@ -1535,18 +1570,7 @@ fn cuts_checked_by_the_parts_relaxations(
     let gap = branch.gap_tolerance;
     let mut checked = Vec::new();
     for (k, coordinate) in coordinates(problem).into_iter().enumerate() {
-        let optimum = match coordinate {
-            Coordinate::AnchorA { spring, i } => {
-                let c = problem.springs[spring].column;
-                x[c + 1 + i] / x[c]
-            }
-            Coordinate::AnchorB { spring, l } => {
-                let s = &problem.springs[spring];
-                x[s.column + 1 + s.axes_a.len() + l] / x[s.column]
-            }
-            Coordinate::Mass { cw } => x[problem.counterweights[cw].column],
-            Coordinate::Moment { cw, k } => x[problem.counterweights[cw].column + 1 + k],
-        };
+        let optimum = coordinate_value(problem, coordinate, &x);
         let [lo, hi] = root.ranges[k];
         if !(lo < optimum && optimum < hi) {
             continue;
@@ -1638,9 +1662,7 @@ fn a_part_cut_off_by_its_dual_rate_holds_no_relaxed_point_below_its_target() {
     let model = palletizer_dmax3();
     let ctx = Context::new(&model, None).unwrap();
     let checked_on = |labels: &[&str]| {
-        let run = new_run(&ctx, &balanced_variant(&model, labels), &options);
-        let problem = run.problem.unwrap();
-        let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+        let (problem, tasks) = problem_and_tasks(&ctx, &model, labels, &options);
         cuts_checked_by_the_parts_relaxations(&problem, &tasks, &options)
     };
     let checked = checked_on(&["m4", "K32", "K73"]);
@@ -1675,9 +1697,7 @@ fn each_recorded_bound_row_measures_its_coordinates_distance_from_its_end() {
     let options = OptimiseOptions::default();
     let branch = options.branch_options();
     for labels in [&["m4", "m5", "K43"][..], &["m4", "K32", "K73"][..]] {
-        let run = new_run(&ctx, &balanced_variant(&model, labels), &options);
-        let problem = run.problem.unwrap();
-        let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+        let (problem, tasks) = problem_and_tasks(&ctx, &model, labels, &options);
         let base = crate::relaxation::RelaxationBase::new(&problem, &tasks, options.objective);
         let root = crate::certify::root_box(&problem, &branch).unwrap();
         let relaxed = base.solve(&problem, Some(&root), 200, &mut Vec::new());
@@ -1696,22 +1716,14 @@ fn each_recorded_bound_row_measures_its_coordinates_distance_from_its_end() {
             for &(k, upper, per_unit, value) in &rows {
                 seen[k][usize::from(upper)] = true;
                 let [lo, hi] = root.ranges[k];
-                let (scale, v) = match coords[k] {
-                    Coordinate::AnchorA { spring, i } => {
+                let v = coordinate_value(&problem, coords[k], &x);
+                // An anchor row is `K` times the distance: `K/K_lo` times its `per_unit`.
+                let scale = match coords[k] {
+                    Coordinate::AnchorA { spring, .. } | Coordinate::AnchorB { spring, .. } => {
                         let s = &problem.springs[spring];
-                        let kk = x[s.column];
-                        (kk / s.bounds.stiffness[0], x[s.column + 1 + i] / kk)
+                        x[s.column] / s.bounds.stiffness[0]
                     }
-                    Coordinate::AnchorB { spring, l } => {
-                        let s = &problem.springs[spring];
-                        let kk = x[s.column];
-                        let na = s.axes_a.len();
-                        (kk / s.bounds.stiffness[0], x[s.column + 1 + na + l] / kk)
-                    }
-                    Coordinate::Mass { cw } => (1.0, x[problem.counterweights[cw].column]),
-                    Coordinate::Moment { cw, k: axis } => {
-                        (1.0, x[problem.counterweights[cw].column + 1 + axis])
-                    }
+                    Coordinate::Mass { .. } | Coordinate::Moment { .. } => 1.0,
                 };
                 let distance = if upper { hi - v } else { v - lo };
                 let expected = scale * per_unit * distance;
