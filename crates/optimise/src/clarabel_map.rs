@@ -12,6 +12,8 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 use serde::Serialize;
 
+use crate::dense_ipm::{self, Block, DenseData, DenseOutcome, Tolerances};
+
 /// clarabel's termination status, one-to-one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -154,6 +156,9 @@ pub struct ConicProblem {
     /// Solves tried at most (clarabel's first run and its retries, see
     /// [`ConicProblem::solve`]); `None` for all of them.
     attempts: Option<u32>,
+    /// Skip the dense interior-point method and solve with clarabel alone (see
+    /// [`ConicProblem::clarabel_only`]).
+    clarabel_only: bool,
 }
 
 /// The outcome of a solve.
@@ -177,6 +182,14 @@ pub struct ConicSolution {
 
 /// Solver runs at most (see [`ConicProblem::solve`]).
 const ATTEMPTS: u32 = 4;
+
+/// Iterations of the dense method at most: it converges in about 20 on the box relaxations or
+/// not at all, and a stalled run should hand over to clarabel soon.
+pub const DENSE_ITERATIONS: u32 = 50;
+
+/// clarabel's default gap and feasibility tolerance, the dense method's when the problem sets
+/// none.
+const CLARABEL_TOLERANCE: f64 = 1e-8;
 
 impl ConicProblem {
     pub fn new_variable(&mut self) -> usize {
@@ -250,6 +263,12 @@ impl ConicProblem {
         self.attempts = Some(attempts.max(1));
     }
 
+    /// Solves with clarabel alone, never with the dense method of [`ConicProblem::solve`]: for
+    /// comparisons between the two.
+    pub fn clarabel_only(&mut self) {
+        self.clarabel_only = true;
+    }
+
     pub fn rows(&self) -> usize {
         self.rhs.len()
     }
@@ -261,12 +280,18 @@ impl ConicProblem {
         self.rhs[i] - terms.iter().map(|&(j, d)| d * x[j]).sum::<f64>()
     }
 
-    /// Solves with clarabel (quiet, deterministic); when clarabel stops short of `Solved`
-    /// without proving infeasibility, retries with more iterations and a more cautious step,
-    /// then with a stronger regularization and more equilibration and optimality tolerances
-    /// of 1e-7, then 1e-6 (recorded in [`ConicSolution::tolerance`]) — the first `Solved`
-    /// wins, otherwise the last status is returned.
+    /// Solves a problem of nonnegative rows and second-order cones first with the dense
+    /// interior-point method of [`crate::dense_ipm`] (at most [`DENSE_ITERATIONS`] iterations),
+    /// which reports only what passes clarabel's own tests; when it ends without a verdict,
+    /// and for any other problem, solves with clarabel (quiet, deterministic); when clarabel
+    /// stops short of `Solved` without proving infeasibility, retries with more iterations and
+    /// a more cautious step, then with a stronger regularization and more equilibration and
+    /// optimality tolerances of 1e-7, then 1e-6 (recorded in [`ConicSolution::tolerance`]) —
+    /// the first `Solved` wins, otherwise the last status is returned.
     pub fn solve(&self, max_iter: u32) -> ConicSolution {
+        if let Some(solution) = self.solve_dense(max_iter) {
+            return solution;
+        }
         let mut last = self.solve_attempt(max_iter, 0);
         for attempt in 1..self.attempts.unwrap_or(ATTEMPTS).min(ATTEMPTS) {
             if last.status == ConicStatus::Solved
@@ -282,6 +307,85 @@ impl ConicProblem {
             };
         }
         last
+    }
+
+    /// The cone as the dense method's blocks (consecutive nonnegative rows merged); `None`
+    /// when it holds an equality or a power cone.
+    fn dense_blocks(&self) -> Option<Vec<Block>> {
+        let mut blocks: Vec<Block> = Vec::with_capacity(self.cones.len());
+        let mut start = 0;
+        for cone in &self.cones {
+            match *cone {
+                Cone::Nonneg(k) => match blocks.last_mut() {
+                    Some(Block::Nonneg { len, .. }) => *len += k,
+                    _ => blocks.push(Block::Nonneg { start, len: k }),
+                },
+                Cone::Soc(k) => blocks.push(Block::Soc { start, len: k }),
+                Cone::Zero(_) | Cone::Pow(_) => return None,
+            }
+            start += match *cone {
+                Cone::Nonneg(k) | Cone::Soc(k) => k,
+                Cone::Zero(_) | Cone::Pow(_) => unreachable!("returned above"),
+            };
+        }
+        Some(blocks)
+    }
+
+    /// The dense method's verdict ([`ConicProblem::solve`]), `None` when it has none.
+    pub(crate) fn solve_dense(&self, max_iter: u32) -> Option<ConicSolution> {
+        if self.clarabel_only {
+            return None;
+        }
+        let blocks = self.dense_blocks()?;
+        let tolerance = self.tolerance.unwrap_or(CLARABEL_TOLERANCE);
+        let data = DenseData {
+            n: self.variables,
+            row_start: &self.row_start,
+            terms: &self.terms,
+            b: &self.rhs,
+            c: &self.objective,
+            blocks: &blocks,
+        };
+        let outcome = dense_ipm::solve(
+            &data,
+            Tolerances::with(tolerance),
+            max_iter.min(DENSE_ITERATIONS),
+        );
+        let solution = |status, x, objective, dual_objective, dual, iterations| ConicSolution {
+            status,
+            x,
+            objective,
+            dual_objective,
+            dual,
+            iterations,
+            attempts: 1,
+            tolerance,
+        };
+        match outcome {
+            DenseOutcome::Solved {
+                x,
+                z,
+                primal_objective,
+                dual_objective,
+                iterations,
+            } => Some(solution(
+                ConicStatus::Solved,
+                x,
+                primal_objective,
+                dual_objective,
+                z,
+                iterations,
+            )),
+            DenseOutcome::PrimalInfeasible { z, iterations } => Some(solution(
+                ConicStatus::PrimalInfeasible,
+                vec![f64::NAN; self.variables],
+                f64::INFINITY,
+                f64::INFINITY,
+                z,
+                iterations,
+            )),
+            DenseOutcome::Failed => None,
+        }
     }
 
     fn solve_attempt(&self, max_iter: u32, attempt: u32) -> ConicSolution {

@@ -26,6 +26,7 @@ pub mod certify;
 pub mod clarabel_map;
 pub mod context;
 pub mod critical;
+pub(crate) mod dense_ipm;
 pub mod diagnose;
 pub mod error;
 pub mod overrides;

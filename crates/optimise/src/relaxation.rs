@@ -466,6 +466,19 @@ impl RelaxationBase {
         built.solve(problem, max_iter, active)
     }
 
+    /// The conic problem [`RelaxationBase::solve`] solves on `node` with every peak row in
+    /// place (its last round).
+    #[cfg(test)]
+    pub(crate) fn box_problem(&self, problem: &VariantProblem, node: &NodeBox) -> ConicProblem {
+        let mut built = self.0.clone();
+        add_node_rows(problem, &mut built, node);
+        built.cp.set_tolerance(BOX_TOLERANCE);
+        for e in built.peaks.iter() {
+            add_peak_row(&mut built.cp, e);
+        }
+        built.cp
+    }
+
     /// Each row of `node`'s relaxation that bounds one coordinate: its coordinate (in
     /// [`crate::certify::node::coordinates`] order), its side, its `per_unit` and its value at
     /// the free point `z` (the conic variables other than `z`'s at 0).
