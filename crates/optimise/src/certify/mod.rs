@@ -390,6 +390,11 @@ fn design_at(
 /// between neighbouring powers, a search's path being sensitive to any change of rule).
 const WIDTH_EXPONENT: f64 = 0.25;
 
+/// Scores within this relative difference are a tie, which the lowest coordinate index wins:
+/// symmetric couplings (a pendulum's two cross terms, equal in exact arithmetic) differ only
+/// by rounding, and the solver's last bits must not choose the path.
+const TIE: f64 = 1e-9;
+
 /// The coordinate to split. The objective depends on the counterweights alone (massless
 /// springs never change a balanced variant's motor torques), so when the true objective at the
 /// relaxed point exceeds the box's bound by more than the tolerance (`counterweights_first`),
@@ -470,7 +475,7 @@ fn branching_coordinate(
             .map(|k| (k, weight(k)))
             .filter(|&(_, w)| w > 0.0)
             .fold(None, |best: Option<(usize, f64)>, (k, w)| match best {
-                Some((_, bw)) if bw >= w => best,
+                Some((_, bw)) if bw * (1.0 + TIE) >= w => best,
                 _ => Some((k, w)),
             })
             .map(|(k, _)| k)
