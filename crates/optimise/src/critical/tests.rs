@@ -1094,8 +1094,11 @@ fn the_boxes_tangent_relaxation_bounds_below_the_power_cones_within_the_gap() {
             // here: clarabel's non-symmetric path makes no progress after four attempts).
             continue;
         }
+        // Each bound is its relaxation's value to the boxes' solver tolerance (1e-6 relative,
+        // the dense method stopping right at it), less the same margin: two values that are
+        // equal in exact arithmetic may cross by twice the tolerance.
         assert!(
-            t.bound <= e.bound + 1e-6 * e.bound.abs(),
+            t.bound <= e.bound + 2.0 * crate::relaxation::BOX_TOLERANCE * e.bound.abs(),
             "box {n}: tangents {} above the power cone {}",
             t.bound,
             e.bound
@@ -1457,25 +1460,31 @@ fn a_variant_without_springs_never_takes_a_siblings_counterweights() {
     );
 }
 
-/// Only a design that still stands is offered (module `siblings`): at Dmax 3, m6 + K53 + K74
-/// alone ends above m6 + K53 + K54 alone, and takes its counterweights when both stand; once
-/// m6 + K53 + K54's run no longer stands (here marked discarded, as a failed all-task check
-/// would), its last design is offered to nobody.
+/// Only a design that still stands is offered (module `siblings`): at Dmax 3, of m6 + K53 + K74
+/// and m6 + K53 + K54 alone (the same counterweight, their optima equal within the gap, so
+/// which ends lower depends on the searches' paths), the one that ends above takes the other's
+/// counterweights when both stand; once the lower run no longer stands (here marked discarded,
+/// as a failed all-task check would), its last design is offered to nobody.
 #[test]
 fn siblings_offer_only_designs_that_still_stand() {
     let model = palletizer_dmax3();
     let ctx = Context::new(&model, None).unwrap();
     let options = OptimiseOptions::default();
-    let mut runs: Vec<Run> = [["m6", "K53", "K54"], ["m6", "K53", "K74"]]
-        .iter()
-        .map(|labels| run_after_loop(&ctx, &balanced_variant(&model, labels), &options))
-        .collect();
     let value = |run: &Run| run.candidate.as_ref().unwrap().working_value;
+    let mut labelled: Vec<([&str; 3], Run)> = [["m6", "K53", "K54"], ["m6", "K53", "K74"]]
+        .into_iter()
+        .map(|labels| {
+            let run = run_after_loop(&ctx, &balanced_variant(&model, &labels), &options);
+            (labels, run)
+        })
+        .collect();
+    labelled.sort_by(|p, q| value(&p.1).total_cmp(&value(&q.1)));
+    let (labels, mut runs): (Vec<[&str; 3]>, Vec<Run>) = labelled.into_iter().unzip();
     assert!(value(&runs[1]) > value(&runs[0]));
     let shared = siblings::sibling_designs(&ctx, &runs, &[0, 1], &options);
     assert_eq!(shared.len(), 1);
     assert_eq!(shared[0].0, 1);
-    assert_eq!(shared[0].1.from, ["m6", "K53", "K54"]);
+    assert_eq!(shared[0].1.from, labels[0]);
     assert!(shared[0].1.design.value < value(&runs[1]));
     runs[0].state = State::Discarded("a peak limit over all tasks".into());
     let shared = siblings::sibling_designs(&ctx, &runs, &[0, 1], &options);
@@ -1739,4 +1748,79 @@ fn each_recorded_bound_row_measures_its_coordinates_distance_from_its_end() {
             assert!(seen.iter().all(|s| s[0] && s[1]), "{labels:?}: {seen:?}");
         }
     }
+}
+
+/// The dense interior-point method against clarabel on the branch-and-bound's own problems:
+/// the first box of three palletizer variants (a hybrid, a hybrid with two springs, two springs
+/// alone) and every box that keeps one coordinate to one quarter of its range (many of them
+/// hold no design). Wherever both reach a verdict they agree: the same objective to the box
+/// tolerance's margin (1e-5 relative), and no box the dense method proves empty is solved by
+/// clarabel. The dense method reaches a verdict on at least 90 % of the boxes (it exists to
+/// spare clarabel's runs; here with every peak row in place, about 1,400 rows, it settles
+/// 115 of 123, and on a whole Dmax 3 run 92 % of the solves), and proves some boxes empty and
+/// solves others.
+#[test]
+fn the_dense_method_agrees_with_clarabel_on_the_boxes_of_three_variants() {
+    use crate::clarabel_map::ConicStatus;
+    let model = palletizer_dmax3();
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let branch = options.branch_options();
+    let (mut verdicts, mut boxes, mut empty, mut solved) = (0, 0, 0, 0);
+    for labels in [
+        &["m4", "K53", "K74"][..],
+        &["m4", "K32", "K73"][..],
+        &["K42", "K54"][..],
+    ] {
+        let (problem, tasks) = problem_and_tasks(&ctx, &model, labels, &options);
+        let base = crate::relaxation::RelaxationBase::new(&problem, &tasks, options.objective);
+        let root = crate::certify::root_box(&problem, &branch).unwrap();
+        let mut nodes = vec![root.clone()];
+        for k in 0..root.ranges.len() {
+            let [lo, hi] = root.ranges[k];
+            for q in 0..4 {
+                let mut node = root.clone();
+                let w = (hi - lo) / 4.0;
+                node.ranges[k] = [lo + w * q as f64, lo + w * (q + 1) as f64];
+                nodes.push(node);
+            }
+        }
+        for node in &nodes {
+            boxes += 1;
+            let cp = base.box_problem(&problem, node);
+            let mut reference = cp.clone();
+            reference.clarabel_only();
+            let clarabel = reference.solve(200);
+            let Some(dense) = cp.solve_dense(200) else {
+                continue;
+            };
+            verdicts += 1;
+            match dense.status {
+                ConicStatus::Solved => {
+                    solved += 1;
+                    if clarabel.status == ConicStatus::Solved {
+                        let scale = 1.0 + clarabel.objective.abs();
+                        assert!(
+                            (dense.objective - clarabel.objective).abs() <= 1e-5 * scale,
+                            "{labels:?} {node:?}: dense {} clarabel {}",
+                            dense.objective,
+                            clarabel.objective
+                        );
+                    } else {
+                        assert!(!clarabel.status.is_infeasible(), "{labels:?} {node:?}");
+                    }
+                }
+                ConicStatus::PrimalInfeasible => {
+                    empty += 1;
+                    assert_ne!(clarabel.status, ConicStatus::Solved, "{labels:?} {node:?}");
+                }
+                other => panic!("the dense method reported {other:?}"),
+            }
+        }
+    }
+    assert!(
+        verdicts as f64 >= 0.9 * boxes as f64,
+        "{verdicts} verdicts on {boxes} boxes"
+    );
+    assert!(empty > 0 && solved > 0, "{empty} empty, {solved} solved");
 }
