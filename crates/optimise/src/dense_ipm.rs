@@ -8,9 +8,10 @@
 //! method is the classic infeasible-start Mehrotra predictor–corrector with Nesterov–Todd
 //! scaling (as in CVXOPT's `coneqp` and ECOS), without the homogeneous embedding. It claims
 //! only what it can check: `Solved` under clarabel's own residual and gap tests (its
-//! definitions on unscaled data, see [`Tolerances`]), `PrimalInfeasible` under clarabel's
-//! certificate test (`bᵀz < 0` with `‖Aᵀz‖` negligible against it, `z` in the dual cone); every
-//! other ending is [`DenseOutcome::Failed`], on which the caller runs clarabel as before.
+//! definitions on unscaled data, see [`Tolerances`]), `PrimalInfeasible` with a certificate it
+//! checks (`z` in the cone, `bᵀz < 0`, `‖Aᵀz‖∞·max(1, ‖x‖∞)` negligible against `|bᵀz|`, see
+//! [`solve`]); every other ending is [`DenseOutcome::Failed`], on which the caller runs
+//! clarabel as before.
 //!
 //! Problems are `min cᵀx` subject to `A x + s = b`, `s ∈ K` (clarabel's form), `K` a product of
 //! nonnegative orthants and second-order cones `s₀ ≥ ‖s₁…‖`; the dual is `max −bᵀz` subject to
@@ -390,7 +391,7 @@ impl DenseData<'_> {
         (dx.as_slice().to_vec(), ds, dz.as_slice().to_vec())
     }
 
-    /// The largest step in `(0, 1]`-units keeping `λ + α ds` and `λ + α dz` in the cone.
+    /// The largest `α` keeping `λ + α ds` and `λ + α dz` in the cone (`∞` when none bounds it).
     fn step(&self, lambda: &[f64], ds: &[f64], dz: &[f64]) -> f64 {
         self.blocks
             .iter()

@@ -228,3 +228,33 @@ fn an_unbounded_program_ends_without_a_verdict() {
     p.nonneg(&[(0, -1.0)], 1.0);
     assert!(matches!(p.solve(), DenseOutcome::Failed));
 }
+
+/// The cone's degree, the `ν` of `μ = sᵀz / ν`: one per nonnegative row, one per second-order
+/// cone whatever its size (the barrier `−log(s₀² − ‖s₁‖²)` counts for two halves of one).
+#[test]
+fn a_blocks_degree_counts_its_rows_or_its_cone() {
+    assert_eq!(Block::Nonneg { start: 3, len: 5 }.degree(), 5);
+    assert_eq!(Block::Soc { start: 3, len: 5 }.degree(), 1);
+    assert_eq!(Block::Soc { start: 0, len: 2 }.degree(), 1);
+}
+
+/// The scaling exists only strictly inside the cone: each condition alone refuses a point
+/// (a zero or negative row, a cone point on the boundary, one with `s₀² > ‖s₁‖²` but `s₀ < 0`).
+#[test]
+fn the_scaling_refuses_points_outside_the_cones_interior() {
+    let refuses = |blk: Block, s: &[f64], z: &[f64]| !Scaling::default().update(&[blk], s, z);
+    let nn = Block::Nonneg { start: 0, len: 2 };
+    assert!(!refuses(nn, &[1.0, 2.0], &[3.0, 4.0]));
+    assert!(refuses(nn, &[1.0, 0.0], &[3.0, 4.0]));
+    assert!(refuses(nn, &[1.0, 2.0], &[0.0, 4.0]));
+    assert!(refuses(nn, &[-1.0, 2.0], &[3.0, 4.0]));
+    assert!(refuses(nn, &[1.0, 2.0], &[3.0, -4.0]));
+    let soc = Block::Soc { start: 0, len: 2 };
+    assert!(!refuses(soc, &[2.0, 1.0], &[3.0, -1.0]));
+    // on the boundary: s₀ = |s₁|, then z₀ = |z₁|
+    assert!(refuses(soc, &[1.0, 1.0], &[3.0, -1.0]));
+    assert!(refuses(soc, &[2.0, 1.0], &[1.0, -1.0]));
+    // in the opposite cone: s₀² − s₁² = 3 > 0 but s₀ < 0, then likewise z
+    assert!(refuses(soc, &[-2.0, 1.0], &[3.0, -1.0]));
+    assert!(refuses(soc, &[2.0, 1.0], &[-3.0, 1.0]));
+}
