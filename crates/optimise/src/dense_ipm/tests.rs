@@ -254,7 +254,9 @@ fn the_scaling_refuses_points_outside_the_cones_interior() {
     // on the boundary: s₀ = |s₁|, then z₀ = |z₁|
     assert!(refuses(soc, &[1.0, 1.0], &[3.0, -1.0]));
     assert!(refuses(soc, &[2.0, 1.0], &[1.0, -1.0]));
-    // in the opposite cone: s₀² − s₁² = 3 > 0 but s₀ < 0, then likewise z
+    // in the opposite cone: s₀² − s₁² = 3 > 0 but s₀ < 0, then likewise z, then both (where
+    // `s̄ᵀz̄ ≥ 1` and every number of the scaling would be finite: only the signs refuse it)
     assert!(refuses(soc, &[-2.0, 1.0], &[3.0, -1.0]));
     assert!(refuses(soc, &[2.0, 1.0], &[-3.0, 1.0]));
+    assert!(refuses(soc, &[-2.0, 1.0], &[-3.0, 1.0]));
 }
