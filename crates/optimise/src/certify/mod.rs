@@ -395,6 +395,17 @@ const WIDTH_EXPONENT: f64 = 0.25;
 /// by rounding, and the solver's last bits must not choose the path.
 const TIE: f64 = 1e-9;
 
+/// The index of the largest weight of `(index, weight)` pairs taken in increasing index order;
+/// a later weight must exceed the best so far by more than [`TIE`] (relative) to replace it.
+fn largest_with_ties_to_the_first(weights: impl Iterator<Item = (usize, f64)>) -> Option<usize> {
+    weights
+        .fold(None, |best: Option<(usize, f64)>, (k, w)| match best {
+            Some((_, bw)) if bw * (1.0 + TIE) >= w => best,
+            _ => Some((k, w)),
+        })
+        .map(|(k, _)| k)
+}
+
 /// The coordinate to split. The objective depends on the counterweights alone (massless
 /// springs never change a balanced variant's motor torques), so when the true objective at the
 /// relaxed point exceeds the box's bound by more than the tolerance (`counterweights_first`),
@@ -470,15 +481,11 @@ fn branching_coordinate(
         }
     }
     let pick = |filter: &dyn Fn(usize) -> bool, weight: &dyn Fn(usize) -> f64| {
-        (0..coords.len())
+        let candidates = (0..coords.len())
             .filter(|&k| filter(k) && relative(k) > 0.0)
             .map(|k| (k, weight(k)))
-            .filter(|&(_, w)| w > 0.0)
-            .fold(None, |best: Option<(usize, f64)>, (k, w)| match best {
-                Some((_, bw)) if bw * (1.0 + TIE) >= w => best,
-                _ => Some((k, w)),
-            })
-            .map(|(k, _)| k)
+            .filter(|&(_, w)| w > 0.0);
+        largest_with_ties_to_the_first(candidates)
     };
     let spring = |k: usize| {
         matches!(
@@ -1015,8 +1022,24 @@ pub fn bounds_in_words(problem: &VariantProblem) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{CUT_SHARE, KeptRanges, NodeBox, TARGET_SHARE, child_order, reduced_cost_cuts};
+    use super::{
+        CUT_SHARE, KeptRanges, NodeBox, TARGET_SHARE, child_order, largest_with_ties_to_the_first,
+        reduced_cost_cuts,
+    };
     use crate::relaxation::EndRate;
+
+    /// Weights within 1e-9 of each other are a tie the first index wins, whichever comes
+    /// larger by rounding; a weight larger by 1e-6 wins wherever it stands.
+    #[test]
+    fn the_split_rule_gives_a_tie_to_the_first_coordinate() {
+        let pick = |w: &[f64]| largest_with_ties_to_the_first(w.iter().copied().enumerate());
+        assert_eq!(pick(&[1.0, 1.0 + 1e-12, 0.5]), Some(0));
+        assert_eq!(pick(&[1.0 + 1e-12, 1.0, 0.5]), Some(0));
+        assert_eq!(pick(&[0.5, 1.0, 1.0 - 1e-12]), Some(1));
+        assert_eq!(pick(&[1.0, 1.0 + 1e-6]), Some(1));
+        assert_eq!(pick(&[1.0 + 1e-6, 1.0]), Some(0));
+        assert_eq!(pick(&[]), None);
+    }
 
     fn end(coordinate: usize, upper: bool, rate: f64) -> EndRate {
         EndRate {

@@ -1790,6 +1790,7 @@ fn the_dense_method_agrees_with_clarabel_on_the_boxes_of_three_variants() {
             let cp = base.box_problem(&problem, node);
             let mut reference = cp.clone();
             reference.clarabel_only();
+            assert!(reference.solve_dense(200).is_none(), "clarabel alone");
             let clarabel = reference.solve(200);
             let Some(dense) = cp.solve_dense(200) else {
                 continue;
