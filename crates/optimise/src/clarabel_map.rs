@@ -316,17 +316,19 @@ impl ConicProblem {
         let mut start = 0;
         for cone in &self.cones {
             match *cone {
-                Cone::Nonneg(k) => match blocks.last_mut() {
-                    Some(Block::Nonneg { len, .. }) => *len += k,
-                    _ => blocks.push(Block::Nonneg { start, len: k }),
-                },
-                Cone::Soc(k) => blocks.push(Block::Soc { start, len: k }),
+                Cone::Nonneg(k) => {
+                    match blocks.last_mut() {
+                        Some(Block::Nonneg { len, .. }) => *len += k,
+                        _ => blocks.push(Block::Nonneg { start, len: k }),
+                    }
+                    start += k;
+                }
+                Cone::Soc(k) => {
+                    blocks.push(Block::Soc { start, len: k });
+                    start += k;
+                }
                 Cone::Zero(_) | Cone::Pow(_) => return None,
             }
-            start += match *cone {
-                Cone::Nonneg(k) | Cone::Soc(k) => k,
-                Cone::Zero(_) | Cone::Pow(_) => unreachable!("returned above"),
-            };
         }
         Some(blocks)
     }
