@@ -19,6 +19,8 @@
 
 use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
 
+use crate::slots::norm;
+
 /// One block of consecutive rows of the cone `K`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Block {
@@ -207,11 +209,8 @@ fn apply_block(block: Block, eta: f64, w: &[f64], v: &[f64], out: &mut [f64], in
 
 /// `x₀² − ‖x₁‖²`.
 fn soc_det(x: &[f64]) -> f64 {
-    (x[0] - norm(&x[1..])) * (x[0] + norm(&x[1..]))
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|a| a * a).sum::<f64>().sqrt()
+    let tail = norm(&x[1..]);
+    (x[0] - tail) * (x[0] + tail)
 }
 
 /// Jordan product `u ∘ v` of one block.
@@ -421,17 +420,12 @@ impl DenseData<'_> {
             })
             .fold(f64::NEG_INFINITY, f64::max);
         if t >= -1e-8 * norm(v).max(1.0) {
-            for &blk in self.blocks {
-                match blk {
-                    Block::Nonneg { start, len } => {
-                        v[start..start + len].iter_mut().for_each(|a| *a += 1.0 + t)
-                    }
-                    Block::Soc { start, .. } => v[start] += 1.0 + t,
-                }
-            }
+            self.identity_into(v, 1.0 + t);
         }
     }
 
+    /// `out += scale·e`, `e` the cone's identity (1 on every nonnegative row, `(1, 0, …)` per
+    /// second-order cone).
     fn identity_into(&self, out: &mut [f64], scale: f64) {
         for &blk in self.blocks {
             match blk {
@@ -443,20 +437,17 @@ impl DenseData<'_> {
         }
     }
 
-    fn jordan_all(&self, u: &[f64], v: &[f64]) -> Vec<f64> {
+    /// `op(block, u, v, out)` on each block's rows of `u` and `v`, into a new vector.
+    fn blockwise(
+        &self,
+        u: &[f64],
+        v: &[f64],
+        op: fn(Block, &[f64], &[f64], &mut [f64]),
+    ) -> Vec<f64> {
         let mut out = vec![0.0; u.len()];
         for &blk in self.blocks {
             let r = blk.range();
-            jordan(blk, &u[r.clone()], &v[r.clone()], &mut out[r]);
-        }
-        out
-    }
-
-    fn jordan_solve_all(&self, lambda: &[f64], r: &[f64]) -> Vec<f64> {
-        let mut out = vec![0.0; r.len()];
-        for &blk in self.blocks {
-            let rr = blk.range();
-            jordan_solve(blk, &lambda[rr.clone()], &r[rr.clone()], &mut out[rr]);
+            op(blk, &u[r.clone()], &v[r.clone()], &mut out[r]);
         }
         out
     }
@@ -563,13 +554,13 @@ pub(crate) fn solve(data: &DenseData<'_>, tol: Tolerances, max_iter: u32) -> Den
         let sigma = (1.0 - alpha_affine).powi(3).clamp(0.0, 1.0);
 
         // Corrector: −λ ∘ λ − Δs_a ∘ Δz_a + σμe.
-        let mut r = data.jordan_all(&lambda, &lambda);
-        let cross = data.jordan_all(&ds_a, &dz_a);
+        let mut r = data.blockwise(&lambda, &lambda, jordan);
+        let cross = data.blockwise(&ds_a, &dz_a, jordan);
         for (ri, ci) in r.iter_mut().zip(&cross) {
             *ri = -*ri - ci;
         }
         data.identity_into(&mut r, sigma * mu);
-        let q = data.jordan_solve_all(&lambda, &r);
+        let q = data.blockwise(&lambda, &r, jordan_solve);
         let (dx, ds, dz) = data.direction(&newton, &rx, &rz, &q);
         let alpha = (STEP_FRACTION * data.step(&lambda, &ds, &dz)).min(1.0);
         if !(alpha > 0.0 && alpha.is_finite()) {

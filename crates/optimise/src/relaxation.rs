@@ -458,21 +458,25 @@ impl RelaxationBase {
         max_iter: u32,
         active: &mut Vec<bool>,
     ) -> Relaxed {
+        self.on_node(problem, node).solve(problem, max_iter, active)
+    }
+
+    /// This relaxation restricted to `node` (its rows added, solved to [`BOX_TOLERANCE`]), or
+    /// the whole family's when `None`.
+    fn on_node(&self, problem: &VariantProblem, node: Option<&NodeBox>) -> Built {
         let mut built = self.0.clone();
         if let Some(node) = node {
             add_node_rows(problem, &mut built, node);
             built.cp.set_tolerance(BOX_TOLERANCE);
         }
-        built.solve(problem, max_iter, active)
+        built
     }
 
     /// The conic problem [`RelaxationBase::solve`] solves on `node` with every peak row in
     /// place (its last round).
     #[cfg(test)]
     pub(crate) fn box_problem(&self, problem: &VariantProblem, node: &NodeBox) -> ConicProblem {
-        let mut built = self.0.clone();
-        add_node_rows(problem, &mut built, node);
-        built.cp.set_tolerance(BOX_TOLERANCE);
+        let mut built = self.on_node(problem, Some(node));
         for e in built.peaks.iter() {
             add_peak_row(&mut built.cp, e);
         }
