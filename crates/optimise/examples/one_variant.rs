@@ -3,7 +3,7 @@
 //! at one variant's optimisation without running the whole study.
 //!
 //! `MAX_NODES` in the environment sets the branch-and-bound's box limit, `SEED` the local
-//! search's start seed (as `run --seed`).
+//! search's start seed (as `run --seed`), `GAP` the relative gap tolerance (as `run --gap`).
 //!
 //! ```text
 //! cargo run --release -p counterpoise-optimise --example one_variant -- CASE DMAX m4+K42 [K32+K42 …]
@@ -50,6 +50,9 @@ fn main() {
     let mut options = OptimiseOptions::default();
     if let Some(n) = std::env::var("MAX_NODES").ok().and_then(|v| v.parse().ok()) {
         options.max_nodes = n;
+    }
+    if let Some(gap) = std::env::var("GAP").ok().and_then(|v| v.parse().ok()) {
+        options.gap_tolerance = gap;
     }
     if let Some(seed) = std::env::var("SEED").ok().and_then(|v| v.parse().ok()) {
         options.start_seed = seed;

@@ -640,6 +640,25 @@ pub fn realize_springs_reusing(
     realize_springs_seeded(problem, b, x, starts, joint, previous, DEFAULT_SEED)
 }
 
+/// The lifted point `x` with every spring's columns replaced by a spring that depends on the
+/// bounds alone: the stiffness at the geometric middle of its range (of `[K_max·1e-3, K_max]`
+/// when the lower bound is 0), both anchors at the origin. Realized from this point, the first
+/// start of [`realize_springs_reusing`] no longer reads the springs a search happened to
+/// realize, so the realizations depend on the counterweights alone; its stiffness is positive,
+/// so that start draws nothing from the stream and the later starts are those of `x`.
+pub fn springs_from_bounds(problem: &VariantProblem, x: &DVector<f64>) -> DVector<f64> {
+    let mut out = x.clone();
+    for s in &problem.springs {
+        let [klo, khi] = s.bounds.stiffness;
+        let klo = if klo > 0.0 { klo } else { khi * 1e-3 };
+        out[s.column] = (klo * khi).sqrt();
+        for c in s.column + 1..s.column + s.lifted_len() {
+            out[c] = 0.0;
+        }
+    }
+    out
+}
+
 /// The seed of the starts after the first (the first start is the lifted point itself).
 pub const DEFAULT_SEED: u64 = 0x5917_6e55_0000_0001;
 

@@ -315,7 +315,7 @@ fn the_spring_choice_keeps_the_lowest_delta_r_of_all_options() {
         let (found, _) = realize_springs(
             problem,
             &ctx.basis.unbalanced,
-            &cand.x,
+            &crate::springs::springs_from_bounds(problem, &cand.x),
             4 * options.spring_starts,
             false,
         );
@@ -359,6 +359,110 @@ fn the_spring_choice_keeps_the_lowest_delta_r_of_all_options() {
         best_positions.iter().any(|&p| p >= 12),
         "{best_positions:?}"
     );
+}
+
+/// Two runs that end at the same counterweights with different springs (the candidate's own
+/// springs swapped for another admissible set of the same counterweights, realized from another
+/// seed's starts, as another `--seed` or search path would leave them) are offered the same
+/// spring options, to the bit, and so get the same ΔR. Realized from the candidates' own lifted
+/// points instead, the first option is each candidate's own springs, and the lists differ.
+#[test]
+fn the_spring_options_depend_on_the_counterweights_alone() {
+    let model = model(&case_json("palletizer.json"));
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let b = &ctx.basis.unbalanced;
+    let joint_tasks: BTreeSet<usize> = ctx
+        .unbalanced
+        .joints
+        .iter()
+        .flat_map(|j| [ctx.task_index(j.force_task), ctx.task_index(j.moment_task)])
+        .flatten()
+        .collect();
+    let found = |o: finish::SpringOptions| match o {
+        finish::SpringOptions::Options { found, .. } => found,
+        _ => panic!("a run with springs has options"),
+    };
+    let bits = |f: &[crate::springs::Realized]| -> Vec<Vec<u64>> {
+        f.iter()
+            .map(|(_, x)| x.iter().map(|v| v.to_bits()).collect())
+            .collect()
+    };
+    for labels in [["m3", "K52"], ["K42", "K53"]] {
+        let run = run_after_loop(&ctx, &balanced_variant(&model, &labels), &options);
+        let problem = run.problem.as_ref().unwrap();
+        let cand = run.candidate.as_ref().unwrap();
+        let (others, _, _) = crate::springs::realize_springs_seeded(
+            problem,
+            b,
+            &cand.x,
+            4 * options.spring_starts,
+            false,
+            None,
+            0x0123_4567,
+        );
+        let spring_part = |x: &DVector<f64>| -> Vec<u64> {
+            problem
+                .springs
+                .iter()
+                .flat_map(|s| (s.column..s.column + s.lifted_len()).map(|c| x[c].to_bits()))
+                .collect()
+        };
+        let (springs, x) = others
+            .into_iter()
+            .rev()
+            .find(|(_, x)| (x - &cand.x).amax() > 1e-3 * cand.x.amax())
+            .expect("another admissible spring set");
+        assert_ne!(spring_part(&x), spring_part(&cand.x), "{labels:?}");
+        let mut other = run.clone();
+        let other_cand = other.candidate.as_mut().unwrap();
+        other_cand.x = x;
+        other_cand.springs = springs;
+        let own = found(finish::spring_options(&ctx, &run, &joint_tasks, &options));
+        let swapped = found(finish::spring_options(&ctx, &other, &joint_tasks, &options));
+        assert!(own.len() >= 2, "{labels:?}: {} options", own.len());
+        assert_eq!(bits(&own), bits(&swapped), "{labels:?}");
+        // What the choice would offer if its first start read each candidate's springs.
+        let from_own_point = |c: &state::Candidate| {
+            realize_springs(problem, b, &c.x, 4 * options.spring_starts, false).0
+        };
+        let (a, z) = (
+            from_own_point(run.candidate.as_ref().unwrap()),
+            from_own_point(other.candidate.as_ref().unwrap()),
+        );
+        assert_ne!(bits(&a), bits(&z), "{labels:?}");
+    }
+}
+
+/// A certified search returns a design where a descent stops (`certify::descended`): at Dmax 3
+/// m3 + K53 + K64's first search, whose gap closes with a design near the counterweight's
+/// mass bound, ends where a second descent from its design finds nothing lower by more than
+/// 1e-12. Without the final descent the design it returns is 3.8e-8 above where a descent from
+/// it goes.
+#[test]
+fn a_certified_design_is_where_a_descent_from_it_stops() {
+    let model = palletizer_dmax3();
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let b = &ctx.basis.unbalanced;
+    let (problem, tasks) = problem_and_tasks(&ctx, &model, &["m3", "K53", "K64"], &options);
+    let branch = options.branch_options();
+    let (verdict, _) =
+        branch_and_bound(&problem, b, &tasks, options.objective, &branch, None, None).unwrap();
+    let Verdict::Optimal { design, .. } = verdict else {
+        panic!("m3 + K53 + K64 is feasible at Dmax 3");
+    };
+    let scale = crate::certify::objective_scale(&tasks);
+    let again = crate::certify::descended(
+        &problem,
+        b,
+        &tasks,
+        options.objective,
+        design.clone(),
+        scale,
+    );
+    let drop = (design.value - again.value) / design.value;
+    assert!((0.0..=1e-12).contains(&drop), "{drop:e}");
 }
 
 /// The products `K·a_i·b_j` of a spring's lifted variables enter no convex bound (only `K`,
