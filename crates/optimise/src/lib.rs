@@ -22,6 +22,7 @@
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
 pub mod anchor_restriction;
+pub mod centre;
 pub mod certify;
 pub mod clarabel_map;
 pub mod context;

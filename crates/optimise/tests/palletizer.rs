@@ -289,6 +289,35 @@ fn the_lifted_radius_check_is_relative_to_the_counterweights_own_mass() {
 /// counterweights and takes the pass's local solves instead of repeating them: the admissible
 /// spring sets found are the same bits as from scratch, the seven starts after the first are
 /// reused, and a record for other counterweights (or for the joint search) is not.
+/// The spring choice's first start (`springs_from_bounds`), by hand: m4 + K42 + K53's springs
+/// get the geometric middle of [1000, 10000] N/m, √1e7 = 3162.28 N/m, and zero anchors in every
+/// other lifted column, m4's columns unchanged; with a lower bound of 0 the range is taken as
+/// [K_max·1e-3, K_max], so [0, 5000] N/m gives √(5·5000) = 158.11 N/m.
+#[test]
+fn the_spring_choice_starts_from_springs_set_by_the_bounds() {
+    use counterpoise_optimise::springs::springs_from_bounds;
+    let model = common::model(&common::case_json("palletizer.json"));
+    let ctx = counterpoise_optimise::Context::new(&model, None).unwrap();
+    let mut problem = variant_problem(&ctx, &["m4", "K42", "K53"]);
+    let x = nalgebra::DVector::from_fn(problem.particular.len(), |i, _| 1.0 + i as f64);
+    let start = springs_from_bounds(&problem, &x);
+    let mut spring_columns = Vec::new();
+    for s in &problem.springs {
+        assert_eq!(s.bounds.stiffness, [1000.0, 10000.0]);
+        assert!((start[s.column] - 3162.2776601683795).abs() < 1e-9);
+        for c in s.column + 1..s.column + s.lifted_len() {
+            assert_eq!(start[c], 0.0, "column {c}");
+        }
+        spring_columns.extend(s.column..s.column + s.lifted_len());
+    }
+    for c in (0..x.len()).filter(|c| !spring_columns.contains(c)) {
+        assert_eq!(start[c], x[c], "column {c}");
+    }
+    problem.springs[0].bounds.stiffness = [0.0, 5000.0];
+    let start = springs_from_bounds(&problem, &x);
+    assert!((start[problem.springs[0].column] - 158.11388300841898).abs() < 1e-9);
+}
+
 #[test]
 fn spring_starts_of_the_pass_are_reused_by_the_choice_exactly() {
     use counterpoise_optimise::springs::realize_springs_reusing;

@@ -1059,6 +1059,27 @@ mod tests {
     };
     use crate::relaxation::EndRate;
 
+    /// The penalty's scale is the largest unbalanced torque magnitude over every task and
+    /// sample (3.5 here, a negative sample of the first task), never below 1e-9.
+    #[test]
+    fn the_objective_scale_is_the_largest_unbalanced_torque() {
+        use crate::torque::TaskTorques;
+        use std::sync::Arc;
+        let task = |task: usize, base: Vec<f64>| {
+            Arc::new(TaskTorques {
+                task,
+                samples: base.len(),
+                actuators: 1,
+                base,
+                sensitivity: Vec::new(),
+            })
+        };
+        let tasks = [task(0, vec![1.0, -3.5]), task(1, vec![2.0, 0.5])];
+        assert_eq!(super::objective_scale(&tasks), 3.5);
+        assert_eq!(super::objective_scale(&[task(2, vec![0.0, 0.0])]), 1e-9);
+        assert_eq!(super::objective_scale(&[]), 1e-9);
+    }
+
     /// Weights within 1e-9 of each other are a tie the first index wins, whichever comes
     /// larger by rounding; a weight larger by 1e-6 wins wherever it stands.
     #[test]

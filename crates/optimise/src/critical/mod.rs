@@ -356,6 +356,8 @@ fn step(
         )));
     }
     let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+    // Every design a pass keeps has the offsets no torque or relation sees centred (`centre`).
+    let centre = |d: Design| crate::centre::centred(problem, &tasks, options.objective, d);
     let relaxed = solve_relaxation(
         problem,
         &tasks,
@@ -445,7 +447,14 @@ fn step(
             )));
         };
         return Ok(candidate(
-            design, 0.0, false, status, &relaxed, gap_before, record, 0,
+            centre(design),
+            0.0,
+            false,
+            status,
+            &relaxed,
+            gap_before,
+            record,
+            0,
         ));
     }
     // The fast path's design is accepted when it is within the gap tolerance of the bound;
@@ -454,7 +463,7 @@ fn step(
         && design.value - lower <= options.gap_tolerance * design.value.abs()
     {
         return Ok(candidate(
-            design.clone(),
+            centre(design.clone()),
             lower,
             true,
             status,
@@ -492,7 +501,7 @@ fn step(
             lower_bound,
             nodes,
         } => Ok(candidate(
-            design,
+            centre(design),
             lower_bound.max(lower),
             true,
             status,

@@ -422,6 +422,23 @@ fn the_spring_options_depend_on_the_counterweights_alone() {
         let swapped = found(finish::spring_options(&ctx, &other, &joint_tasks, &options));
         assert!(own.len() >= 2, "{labels:?}: {} options", own.len());
         assert_eq!(bits(&own), bits(&swapped), "{labels:?}");
+        // The start from the bounds draws nothing from the stream: the pass's other starts
+        // are still taken from its record where the counterweights are those the pass realized
+        // springs for (not m3 + K52's: its m3 was centred after, see `centre`).
+        let (_, _, record) = crate::springs::realize_springs_reusing(
+            problem,
+            b,
+            &crate::springs::springs_from_bounds(problem, &cand.x),
+            4 * options.spring_starts,
+            false,
+            cand.spring_starts.as_ref(),
+        );
+        let reused = if labels[0] == "m3" {
+            0
+        } else {
+            options.spring_starts - 1
+        };
+        assert_eq!(record.reused(), reused, "{labels:?}");
         // What the choice would offer if its first start read each candidate's springs.
         let from_own_point = |c: &state::Candidate| {
             realize_springs(problem, b, &c.x, 4 * options.spring_starts, false).0
@@ -463,6 +480,86 @@ fn a_certified_design_is_where_a_descent_from_it_stops() {
     );
     let drop = (design.value - again.value) / design.value;
     assert!((0.0..=1e-12).contains(&drop), "{drop:e}");
+    // Moved off its minimum (m3's offset along x, which no relation holds but the motors feel,
+    // cut by a tenth), the design is worse, and a descent brings it back down.
+    let m3 = &problem.counterweights[0];
+    let column = m3.column + 1 + m3.axes.iter().position(|&a| a == 0).unwrap();
+    let mut x = design.x.clone();
+    x[column] *= 0.9;
+    let moved = crate::certify::verified_design(
+        &problem,
+        &tasks,
+        options.objective,
+        design.springs.clone(),
+        x,
+    )
+    .expect("the moved design meets every bound");
+    assert!(moved.value > design.value * (1.0 + 1e-6), "{}", moved.value);
+    let back =
+        crate::certify::descended(&problem, b, &tasks, options.objective, moved.clone(), scale);
+    assert!(
+        back.value < moved.value - 0.5 * (moved.value - design.value),
+        "{} from {} (the minimum {})",
+        back.value,
+        moved.value,
+        design.value
+    );
+}
+
+/// m3 sits on slider_v, which turns about the vertical axis only: in m3 + K42 + K76 at Dmax 3
+/// its height y on the slider is free (`centre::free_offsets`: no relation holds it, no torque
+/// depends on it), its x is not (the inertia about the vertical axis); m4 on the upper arm
+/// (m4 + K53 + K54), which also turns about its own joint, has no free offset. The pass leaves
+/// the design centred (y = 0). Second method: the whole grid's inverse dynamics (every task,
+/// gravity included, `evaluate_grid`) of that design with m3's y at 0 and at ±0.2 m: every
+/// task's motor RMS and peak agree to 1e-9, and the joint moments do not.
+#[test]
+fn an_offset_no_torque_or_relation_sees_is_centred() {
+    let model = palletizer_dmax3();
+    let ctx = Context::new(&model, None).unwrap();
+    let options = OptimiseOptions::default();
+    let labels = ["m3", "K42", "K76"];
+    let (problem, tasks) = problem_and_tasks(&ctx, &model, &labels, &options);
+    let m3 = &problem.counterweights[0];
+    let axis = |a: usize| m3.column + 1 + m3.axes.iter().position(|&b| b == a).unwrap();
+    assert_eq!(crate::centre::free_offsets(&problem, &tasks), vec![axis(1)]);
+    let (other, other_tasks) = problem_and_tasks(&ctx, &model, &["m4", "K53", "K54"], &options);
+    assert!(crate::centre::free_offsets(&other, &other_tasks).is_empty());
+    let run = run_after_loop(&ctx, &balanced_variant(&model, &labels), &options);
+    let problem = run.problem.as_ref().unwrap();
+    let cand = run.candidate.as_ref().unwrap();
+    assert_eq!(cand.cws[0].mu[1], 0.0);
+    assert_ne!(cand.cws[0].mu[0], 0.0);
+    let variants: Vec<Variant> = [0.0, 0.2, -0.2]
+        .iter()
+        .map(|&y| {
+            let mut cws = cand.cws.clone();
+            cws[0].mu[1] = y * cws[0].mass;
+            grid::dynamics_variant(&ctx.model, problem, &cws, &cand.springs)
+        })
+        .collect();
+    let params = ParameterSet::from_variants(&ctx.model, &variants).unwrap();
+    let grid = evaluate_grid(&ctx.model, &params, &EvaluateOptions::default()).unwrap();
+    let (mut tasks_compared, mut moments_differ) = (0, false);
+    for w in 0..ctx.tasks.len() {
+        let Some(centred) = grid.stats(w, 0) else {
+            continue;
+        };
+        tasks_compared += 1;
+        for c in 1..3 {
+            let moved = grid.stats(w, c).unwrap();
+            let close = |p: &[f64], q: &[f64]| {
+                p.iter()
+                    .zip(q)
+                    .all(|(a, b)| (a - b).abs() <= 1e-9 * b.abs().max(1.0))
+            };
+            assert!(close(&moved.rms, &centred.rms), "task {w}");
+            assert!(close(&moved.peak, &centred.peak), "task {w}");
+            moments_differ |= !close(&moved.moment_peak, &centred.moment_peak);
+        }
+    }
+    assert!(tasks_compared > 1000, "{tasks_compared}");
+    assert!(moments_differ);
 }
 
 /// The products `K·a_i·b_j` of a spring's lifted variables enter no convex bound (only `K`,
