@@ -10,16 +10,16 @@
 //! bounds allow it (a radius floor may not). The motor torques are those of the design before,
 //! so the objective, the peak limits and the certified bound keep their meaning.
 //!
-//! An axis is free when its first moment is a direction of the balanced family on its own (no
-//! balance relation holds it) and the torque of every actuator on every sample of the working
+//! An axis is free when its first moment's column of the balance system is zero (no balance
+//! relation holds it, so it is a direction of the balanced family on its own; the anchor
+//! restriction only adds rows on spring variables) and the torque of every actuator on every
+//! sample of the working
 //! set's tasks is independent of it: the first moment's column and every inertia column the
 //! offset enters (the products of inertia with that axis, the moments about the other two) are
 //! zero, to 1e-12 of the body's largest column. The loop's all-task evaluation then checks the
 //! centred design on every other task, as it checks every design.
 
 use std::sync::Arc;
-
-use nalgebra::DVector;
 
 use crate::certify::{Design, verified_design};
 use crate::problem::{Objective, VariantProblem};
@@ -54,14 +54,9 @@ fn offset_columns(axis: usize) -> Vec<usize> {
 /// The lifted columns (first moments `m·r_a`) of the counterweight offsets that no balance
 /// relation holds and no torque on `tasks` depends on (see the module doc).
 pub fn free_offsets(problem: &VariantProblem, tasks: &[Arc<TaskTorques>]) -> Vec<usize> {
-    let n = &problem.nullspace;
-    let svd = n.clone().svd(true, true);
-    let in_family = |column: usize| {
-        let mut e = DVector::zeros(n.nrows());
-        e[column] = 1.0;
-        svd.solve(&e, 1e-12)
-            .is_ok_and(|y| (n * y - &e).amax() <= 1e-9)
-    };
+    // No balance relation holds a lifted variable whose column of the balance system is zero.
+    let matrix = &problem.solution.matrix;
+    let in_no_relation = |column: usize| matrix.column(column).iter().all(|&v| v == 0.0);
     let mut free = Vec::new();
     for c in &problem.counterweights {
         let largest = tasks
@@ -77,7 +72,7 @@ pub fn free_offsets(problem: &VariantProblem, tasks: &[Arc<TaskTorques>]) -> Vec
                         .all(|v| v.abs() <= ZERO_COLUMN * largest)
                 })
             });
-            if torque_free && in_family(column) {
+            if torque_free && in_no_relation(column) {
                 free.push(column);
             }
         }

@@ -242,9 +242,14 @@ fn better_design(
             None,
             options.start_seed,
         );
-        let design = found.into_iter().find_map(|(springs, x_full)| {
-            verified_design(problem, &tasks, options.objective, springs, x_full)
-        });
+        // Their offsets come through a least-squares fit of this family, so the ones no torque
+        // or relation sees are centred again (`centre`).
+        let design = found
+            .into_iter()
+            .find_map(|(springs, x_full)| {
+                verified_design(problem, &tasks, options.objective, springs, x_full)
+            })
+            .map(|d| crate::centre::centred(problem, &tasks, options.objective, d));
         if let Some(design) = design.filter(|d| d.value < own.working_value) {
             return Some(SharedDesign {
                 design,

@@ -508,7 +508,8 @@ fn a_certified_design_is_where_a_descent_from_it_stops() {
 
 /// m3 sits on slider_v, which turns about the vertical axis only: in m3 + K42 + K76 at Dmax 3
 /// its height y on the slider is free (`centre::free_offsets`: no relation holds it, no torque
-/// depends on it), its x is not (the inertia about the vertical axis); m4 on the upper arm
+/// depends on it; also in m3 + K43 + K72, whose family the anchor restriction narrows), its x
+/// is not (the inertia about the vertical axis); m4 on the upper arm
 /// (m4 + K53 + K54), which also turns about its own joint, has no free offset. The pass leaves
 /// the design centred (y = 0). Second method: the whole grid's inverse dynamics (every task,
 /// gravity included, `evaluate_grid`) of that design with m3's y at 0 and at ±0.2 m: every
@@ -523,6 +524,14 @@ fn an_offset_no_torque_or_relation_sees_is_centred() {
     let m3 = &problem.counterweights[0];
     let axis = |a: usize| m3.column + 1 + m3.axes.iter().position(|&b| b == a).unwrap();
     assert_eq!(crate::centre::free_offsets(&problem, &tasks), vec![axis(1)]);
+    // The same with a spring whose anchors the family restricts (K72: its anchor a_y held at
+    // 0), where the restricted family is only known to its rounding.
+    let (restricted, restricted_tasks) =
+        problem_and_tasks(&ctx, &model, &["m3", "K43", "K72"], &options);
+    assert_eq!(
+        crate::centre::free_offsets(&restricted, &restricted_tasks),
+        vec![restricted.counterweights[0].column + 2]
+    );
     let (other, other_tasks) = problem_and_tasks(&ctx, &model, &["m4", "K53", "K54"], &options);
     assert!(crate::centre::free_offsets(&other, &other_tasks).is_empty());
     let run = run_after_loop(&ctx, &balanced_variant(&model, &labels), &options);
