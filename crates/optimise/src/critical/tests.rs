@@ -532,6 +532,24 @@ fn an_offset_no_torque_or_relation_sees_is_centred() {
         crate::centre::free_offsets(&restricted, &restricted_tasks),
         vec![restricted.counterweights[0].column + 2]
     );
+    // "Zero" is relative to the body's largest column: a first-moment sample of 1e-13 of it
+    // leaves the offset free, one of 1e-10 does not.
+    let slot = m3.torque_slot;
+    let largest = tasks
+        .iter()
+        .flat_map(|t| (0..10).flat_map(move |j| t.sens(slot, j).iter()))
+        .fold(0.0f64, |a, &v| a.max(v.abs()));
+    for (share, free) in [(1e-13, vec![axis(1)]), (1e-10, vec![])] {
+        let mut touched: Vec<Arc<TaskTorques>> = tasks.clone();
+        let mut first = (*touched[0]).clone();
+        first.sensitivity[slot * 10 + 2][0] = share * largest;
+        touched[0] = Arc::new(first);
+        assert_eq!(
+            crate::centre::free_offsets(&problem, &touched),
+            free,
+            "{share}"
+        );
+    }
     let (other, other_tasks) = problem_and_tasks(&ctx, &model, &["m4", "K53", "K54"], &options);
     assert!(crate::centre::free_offsets(&other, &other_tasks).is_empty());
     let run = run_after_loop(&ctx, &balanced_variant(&model, &labels), &options);
