@@ -13,13 +13,14 @@
 //! An axis is free when its first moment's column of the balance system is zero (no balance
 //! relation holds it, so it is a direction of the balanced family on its own; the anchor
 //! restriction only adds rows on spring variables) and the torque of every actuator on every
-//! sample of the working
-//! set's tasks is independent of it: the first moment's column and every inertia column the
-//! offset enters (the products of inertia with that axis, the moments about the other two) are
-//! zero, to 1e-12 of the body's largest column. The loop's all-task evaluation then checks the
-//! centred design on every other task, as it checks every design.
+//! sample of the working set's tasks is independent of it: the first moment's column and every
+//! inertia column the offset enters (the products of inertia with that axis, the moments about
+//! the other two) are zero, to 1e-12 of the body's largest column. The loop's all-task
+//! evaluation then checks the centred design on every other task, as it checks every design.
 
 use std::sync::Arc;
+
+use counterpoise_dynamics::params::BODY_PARAMS;
 
 use crate::certify::{Design, verified_design};
 use crate::problem::{Objective, VariantProblem};
@@ -61,7 +62,7 @@ pub fn free_offsets(problem: &VariantProblem, tasks: &[Arc<TaskTorques>]) -> Vec
     for c in &problem.counterweights {
         let largest = tasks
             .iter()
-            .flat_map(|t| (0..10).flat_map(move |j| t.sens(c.torque_slot, j).iter()))
+            .flat_map(|t| (0..BODY_PARAMS).flat_map(move |j| t.sens(c.torque_slot, j).iter()))
             .fold(0.0f64, |a, &v| a.max(v.abs()));
         for (p, &axis) in c.axes.iter().enumerate() {
             let column = c.column + 1 + p;
@@ -138,7 +139,9 @@ mod tests {
                 body_params(2.0, &up, &Matrix3::zeros()),
                 body_params(2.0, &down, &Matrix3::zeros()),
             );
-            let moved: Vec<usize> = (0..10).filter(|&j| (pu[j] - pd[j]).abs() > 1e-12).collect();
+            let moved: Vec<usize> = (0..BODY_PARAMS)
+                .filter(|&j| (pu[j] - pd[j]).abs() > 1e-12)
+                .collect();
             let mut listed = offset_columns(axis);
             listed.sort_unstable();
             assert_eq!(moved, listed, "axis {axis}");

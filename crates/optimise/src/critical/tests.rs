@@ -12,7 +12,7 @@ use crate::torque::TaskTorques;
 use counterpoise_balance::{Catalogue, SearchOptions, catalogue_options, mechanism_energy};
 use counterpoise_balance::{realization_hints, search};
 use counterpoise_dynamics::evaluate_grid;
-use counterpoise_dynamics::params::{Counterweight, ParameterSet, Spring, Variant};
+use counterpoise_dynamics::params::{BODY_PARAMS, Counterweight, ParameterSet, Spring, Variant};
 use counterpoise_dynamics::{EvaluateOptions, Indicators};
 use counterpoise_model::{Case, Model};
 use std::sync::Arc;
@@ -537,12 +537,12 @@ fn an_offset_no_torque_or_relation_sees_is_centred() {
     let slot = m3.torque_slot;
     let largest = tasks
         .iter()
-        .flat_map(|t| (0..10).flat_map(move |j| t.sens(slot, j).iter()))
+        .flat_map(|t| (0..BODY_PARAMS).flat_map(move |j| t.sens(slot, j).iter()))
         .fold(0.0f64, |a, &v| a.max(v.abs()));
     for (share, free) in [(1e-13, vec![axis(1)]), (1e-10, vec![])] {
         let mut touched: Vec<Arc<TaskTorques>> = tasks.clone();
         let mut first = (*touched[0]).clone();
-        first.sensitivity[slot * 10 + 2][0] = share * largest;
+        first.sensitivity[slot * BODY_PARAMS + 2][0] = share * largest;
         touched[0] = Arc::new(first);
         assert_eq!(
             crate::centre::free_offsets(&problem, &touched),
