@@ -285,10 +285,6 @@ fn the_lifted_radius_check_is_relative_to_the_counterweights_own_mass() {
     assert!((worst - 1e-6).abs() < 1e-9, "largest violation {worst}");
 }
 
-/// The spring choice runs four times the starts of the critical-task pass for the same
-/// counterweights and takes the pass's local solves instead of repeating them: the admissible
-/// spring sets found are the same bits as from scratch, the seven starts after the first are
-/// reused, and a record for other counterweights (or for the joint search) is not.
 /// The spring choice's first start (`springs_from_bounds`), by hand: m4 + K42 + K53's springs
 /// get the geometric middle of [1000, 10000] N/m, √1e7 = 3162.28 N/m, and zero anchors in every
 /// other lifted column, m4's columns unchanged; with a lower bound of 0 the range is taken as
@@ -318,6 +314,10 @@ fn the_spring_choice_starts_from_springs_set_by_the_bounds() {
     assert!((start[problem.springs[0].column] - 158.11388300841898).abs() < 1e-9);
 }
 
+/// The spring choice runs four times the starts of the critical-task pass for the same
+/// counterweights and takes the pass's local solves instead of repeating them: the admissible
+/// spring sets found are the same bits as from scratch, the seven starts after the first are
+/// reused, and a record for other counterweights (or for the joint search) is not.
 #[test]
 fn spring_starts_of_the_pass_are_reused_by_the_choice_exactly() {
     use counterpoise_optimise::springs::realize_springs_reusing;
