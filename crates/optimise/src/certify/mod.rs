@@ -23,8 +23,10 @@
 //!   relaxed point promised a better design but none was realized); midpoint splits shrink every
 //!   box, so the relaxation converges to the true problem and the search terminates;
 //! - **stops** when the best design is within the gap tolerance of the smallest open bound
-//!   (certified optimum), when no box is left (proved impossible), or at the node budget
-//!   (the only undecided outcome, a user-set limit).
+//!   (certified optimum; before it returns, the relaxed points of the boxes it closed or left
+//!   unopened are tried for a better design, module `untried`, and the best is descended), when
+//!   no box is left (proved impossible), or at the node budget (the only undecided outcome, a
+//!   user-set limit).
 //!
 //! The order of work is fixed (best bound first, ties by creation order) and every step is
 //! deterministic, so the verdict, the design and the bound do not depend on threads or batches.
@@ -35,6 +37,7 @@ pub(crate) mod coupling;
 pub mod node;
 mod polish;
 mod split_history;
+mod untried;
 
 use std::sync::Arc;
 
@@ -51,6 +54,7 @@ use crate::torque::TaskTorques;
 use coupling::coupling_projectors;
 use node::{Coordinate, NodeBox, coordinates};
 use split_history::SplitHistory;
+use untried::Untried;
 
 /// Boxes per variant and pass by default: enough to close every gap of the palletizer at
 /// Dmax 2 and Dmax 3 to the default tolerance (the most one pass needs at Dmax 3 is 2,711, a
@@ -720,6 +724,8 @@ pub fn branch_and_bound(
     // The boxes closed because their bound came within the tolerance of the best design (their
     // bounds are part of the certified lower bound).
     let mut pruned: Vec<(NodeBox, f64)> = Vec::new();
+    // The relaxed points of the boxes closed unopened (module `untried`).
+    let mut untried = Untried::default();
     let closes = |bound: f64, best: &Option<Design>| {
         best.as_ref().is_some_and(|d| {
             d.value - bound <= options.gap_tolerance * d.value.abs().max(f64::MIN_POSITIVE)
@@ -743,12 +749,21 @@ pub fn branch_and_bound(
             }
         };
         if open.is_empty() || closes(lowest, &best) {
+            let mut untried = std::mem::take(&mut untried);
+            for o in &open {
+                if let Some(z) = &o.z {
+                    untried.push(o.bound, o.order, z);
+                }
+            }
             let state = finish(open, stuck.clone(), pruned);
             return Ok((
                 match best {
                     Some(design) if stuck.is_empty() || closes(lowest, &Some(design.clone())) => {
-                        // The gap closed; the design still goes down to where a descent stops
+                        // The gap closed; the relaxed points left untried are tried (module
+                        // `untried`), and the best design goes down to where a descent stops
                         // (see [`descended`]).
+                        let design =
+                            best_of_untried(problem, b, tasks, objective, design, untried, scale);
                         let design = descended(problem, b, tasks, objective, design, scale);
                         let lower_bound = lowest.min(design.value);
                         Verdict::Optimal {
@@ -899,6 +914,9 @@ pub fn branch_and_bound(
         order += 2;
         for o in children.into_iter().flatten() {
             if closes(o.bound, &best) {
+                if let Some(z) = &o.z {
+                    untried.push(o.bound, o.order, z);
+                }
                 pruned.push((o.node, o.bound));
             } else {
                 open.push(o);
@@ -939,6 +957,73 @@ pub(crate) fn descended(
     polish::descend(problem, b, tasks, objective, &design, scale)
         .filter(|p| p.value < design.value)
         .unwrap_or(design)
+}
+
+/// The best of `design` and the verified designs found at the `untried` relaxed points (module
+/// `untried`), tried in bound order where a point's own objective is below the best design's
+/// so far; a design found replaces the best only when it is strictly better.
+fn best_of_untried(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    design: Design,
+    untried: Untried,
+    scale: f64,
+) -> Design {
+    untried
+        .in_bound_order()
+        .into_iter()
+        .fold(design, |best, z| {
+            let (_, value, _) = merit(
+                problem,
+                tasks,
+                objective,
+                &project_fixed(problem, &z),
+                scale,
+            );
+            if value >= best.value {
+                return best;
+            }
+            match design_at(problem, b, tasks, objective, &z, scale) {
+                Some(d) if d.value < best.value => d,
+                _ => best,
+            }
+        })
+}
+
+/// The last pass's design (lifted point `x`, springs `springs`) carried to this pass's tasks:
+/// descended from ([`descended`]) where it still meets every bound and limit on them, else the
+/// best verified design a descent from it reaches (`None` when the descent meets none).
+///
+/// A pass that adds tasks starts a new search, whose first design comes from the fast path,
+/// which realizes springs from seeded starts: two runs whose last passes ended at the same
+/// design then began the next pass from different ones and could end in different valleys
+/// within the gap of each other (m5 + K32 + K73 at Dmax 3 on the palletizer, after both seeds'
+/// first passes met at 11.6801716 N·m: 11.680181 or 11.681675 N·m). Carrying the last design
+/// gives every run the same start where the last passes agree.
+pub(crate) fn carried(
+    problem: &VariantProblem,
+    b: &DVector<f64>,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    x: &DVector<f64>,
+    springs: &[Spring],
+) -> Option<Design> {
+    let scale = objective_scale(tasks);
+    match verified_design(problem, tasks, objective, springs.to_vec(), x.clone()) {
+        Some(d) => Some(descended(problem, b, tasks, objective, d, scale)),
+        None => {
+            // Only the start's lifted point matters to the descent.
+            let start = Design {
+                x: x.clone(),
+                cws: Vec::new(),
+                springs: Vec::new(),
+                value: f64::INFINITY,
+            };
+            polish::descend(problem, b, tasks, objective, &start, scale)
+        }
+    }
 }
 
 /// Smallest share of a coordinate's width that a reduced-cost cut must remove to be made: each

@@ -219,7 +219,8 @@ pub(super) enum SpringOptions {
 }
 
 /// The spring options of one run (the admissible spring sets from four times the pass's
-/// starts; the candidate's own springs when none is found), scored on the reaction tasks plus
+/// starts; when none is found, for a variant of springs alone the first design of a search
+/// without an incumbent, [`springs_only_design`], else the candidate's own springs), scored on the reaction tasks plus
 /// the run's working set. The first start takes its springs from the bounds
 /// ([`crate::springs::springs_from_bounds`]), not from the candidate: the candidate's springs
 /// are where its search happened to realize them, so two searches that end at the same
@@ -253,7 +254,10 @@ pub(super) fn spring_options(
         cand.spring_starts.as_ref(),
     );
     if found.is_empty() {
-        found.push((cand.springs.clone(), cand.x.clone()));
+        found.push(
+            springs_only_design(ctx, run, problem, options)
+                .unwrap_or_else(|| (cand.springs.clone(), cand.x.clone())),
+        );
     }
     let variants: Vec<Variant> = found
         .iter()
@@ -270,6 +274,47 @@ pub(super) fn spring_options(
         found,
         variants,
         tasks,
+    }
+}
+
+/// For a variant of springs alone, the springs of the first design a search from the first box
+/// finds on the run's working tasks, when it finds one (`None` for a variant with
+/// counterweights).
+///
+/// The spring choice falls back on the candidate's own springs when none of its starts
+/// realizes the springs within the bounds; for a variant of springs alone those come from the
+/// fast path's seeded starts, or from wherever the search's path met a design (every design of
+/// such a variant has the same objective, so the first one closes the gap). Two seeds then
+/// reported different springs, hence ΔR, for the same variant (on the palletizer at Dmax 3,
+/// K31 + K61 + K63: 14.22 or 15.44 %). A search from the first box without an incumbent
+/// draws nothing from the seed, so its first design is the same in every run.
+fn springs_only_design(
+    ctx: &Context,
+    run: &Run,
+    problem: &VariantProblem,
+    options: &OptimiseOptions,
+) -> Option<crate::springs::Realized> {
+    if !problem.counterweights.is_empty() {
+        return None;
+    }
+    let (tasks, _) = ctx.torques.get(&ctx.model, &ctx.tasks, &run.working);
+    let (verdict, _) = crate::certify::branch_and_bound(
+        problem,
+        &ctx.basis.unbalanced,
+        &tasks,
+        options.objective,
+        &options.branch_options(),
+        None,
+        None,
+    )
+    .ok()?;
+    match verdict {
+        crate::certify::Verdict::Optimal { design, .. }
+        | crate::certify::Verdict::Stopped {
+            design: Some(design),
+            ..
+        } => Some((design.springs, design.x)),
+        _ => None,
     }
 }
 

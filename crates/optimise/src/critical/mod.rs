@@ -457,9 +457,26 @@ fn step(
             0,
         ));
     }
-    // The fast path's design is accepted when it is within the gap tolerance of the bound;
+    let b = &ctx.basis.unbalanced;
+    let (fast, record) = match fast {
+        Some((d, r)) => (Some(d), r),
+        None => (None, None),
+    };
+    // The last pass's design, carried to this pass's tasks (see `certify::carried`), is the
+    // first design where it is at least as good as the fast path's.
+    let carried = run.candidate.as_ref().and_then(|c| {
+        crate::certify::carried(problem, b, &tasks, options.objective, &c.x, &c.springs)
+    });
+    // The fast path's record of spring starts goes with its design only (the spring choice
+    // reuses it for the same counterweights).
+    let (incumbent, record) = match (fast, carried) {
+        (Some(f), Some(c)) if c.value <= f.value => (Some(c), None),
+        (Some(f), _) => (Some(f), record),
+        (None, c) => (c, None),
+    };
+    // The first design is accepted when it is within the gap tolerance of the bound;
     // otherwise the branch-and-bound certifies the optimum or proves that none exists.
-    if let Some((design, record)) = &fast
+    if let Some(design) = &incumbent
         && design.value - lower <= options.gap_tolerance * design.value.abs()
     {
         return Ok(candidate(
@@ -469,16 +486,11 @@ fn step(
             status,
             &relaxed,
             gap_before,
-            record.clone(),
+            record,
             0,
         ));
     }
-    let (incumbent, record) = match fast {
-        Some((d, r)) => (Some(d), r),
-        None => (None, None),
-    };
     let branch = options.branch_options();
-    let b = &ctx.basis.unbalanced;
     let (verdict, state) = branch_and_bound(
         problem,
         b,
