@@ -804,6 +804,30 @@ fn a_box_the_lagrange_cones_leave_undecided_is_bounded_without_them() {
     assert!(b[1] <= 0.5 * (1.0 + 1e-9), "by = {}", b[1]);
 }
 
+/// The Dmax 3 variant `labels` optimised under each start seed of `seeds`, each checked
+/// feasible, within the gap tolerance and verified.
+fn feasible_under_seeds(
+    labels: &[&str],
+    seeds: &[u64],
+) -> Vec<counterpoise_optimise::OptimisedVariant> {
+    let model = palletizer_dmax3();
+    seeds
+        .iter()
+        .map(|&seed| {
+            let options = OptimiseOptions {
+                start_seed: seed,
+                ..OptimiseOptions::default()
+            };
+            let (_, mut results) = common::optimise(&model, &[labels], &options);
+            let v = results.pop().unwrap();
+            assert_eq!(v.status, Status::Feasible, "seed {seed}: {:?}", v.reason);
+            assert!(v.gap.unwrap() <= 1e-3, "seed {seed}: gap {:?}", v.gap);
+            assert!(v.verification.as_ref().unwrap().passed, "seed {seed}");
+            v
+        })
+        .collect()
+}
+
 /// `m5 + K32 + K73` at Dmax 3 has two valleys within the gap tolerance of each other: a
 /// 210.9 kg m5 at 11.680172 N·m, and a 202.0 kg m5 at 11.681715 N·m. The default seed used to
 /// end near the first (11.680181 N·m) and `--seed 12345` in the second: their paths met
@@ -813,22 +837,10 @@ fn a_box_the_lagrange_cones_leave_undecided_is_bounded_without_them() {
 /// of the certified bound.
 #[test]
 fn two_seeds_end_a_variant_with_two_valleys_in_the_same_one() {
-    let model = palletizer_dmax3();
-    let designs: Vec<_> = [counterpoise_optimise::springs::DEFAULT_SEED, 12345]
-        .into_iter()
-        .map(|seed| {
-            let options = OptimiseOptions {
-                start_seed: seed,
-                ..OptimiseOptions::default()
-            };
-            let (_, mut results) = common::optimise(&model, &[&["m5", "K32", "K73"]], &options);
-            let v = results.pop().unwrap();
-            assert_eq!(v.status, Status::Feasible, "seed {seed}: {:?}", v.reason);
-            assert!(v.gap.unwrap() <= 1e-3, "seed {seed}: gap {:?}", v.gap);
-            assert!(v.verification.as_ref().unwrap().passed, "seed {seed}");
-            v
-        })
-        .collect();
+    let designs = feasible_under_seeds(
+        &["m5", "K32", "K73"],
+        &[counterpoise_optimise::springs::DEFAULT_SEED, 12345],
+    );
     let (a, b) = (&designs[0], &designs[1]);
     let (va, vb) = (a.objective.unwrap(), b.objective.unwrap());
     // The lower valley (the upper one is 11.6817).
@@ -847,21 +859,10 @@ fn two_seeds_end_a_variant_with_two_valleys_in_the_same_one() {
 /// an incumbent: the same springs, hence the same ΔR, under every seed.
 #[test]
 fn a_springs_only_variant_gets_the_same_springs_under_every_seed() {
-    let model = palletizer_dmax3();
-    let runs: Vec<_> = [counterpoise_optimise::springs::DEFAULT_SEED, 12345, 7]
-        .into_iter()
-        .map(|seed| {
-            let options = OptimiseOptions {
-                start_seed: seed,
-                ..OptimiseOptions::default()
-            };
-            let (_, mut results) = common::optimise(&model, &[&["K31", "K61", "K63"]], &options);
-            let v = results.pop().unwrap();
-            assert_eq!(v.status, Status::Feasible, "seed {seed}: {:?}", v.reason);
-            assert!(v.verification.as_ref().unwrap().passed, "seed {seed}");
-            v
-        })
-        .collect();
+    let runs = feasible_under_seeds(
+        &["K31", "K61", "K63"],
+        &[counterpoise_optimise::springs::DEFAULT_SEED, 12345, 7],
+    );
     for v in &runs[1..] {
         for (s, t) in v.springs.iter().zip(&runs[0].springs) {
             assert_eq!(s.stiffness.to_bits(), t.stiffness.to_bits(), "{}", s.label);

@@ -458,22 +458,12 @@ fn step(
         ));
     }
     let b = &ctx.basis.unbalanced;
-    let (fast, record) = match fast {
-        Some((d, r)) => (Some(d), r),
-        None => (None, None),
-    };
-    // The last pass's design, carried to this pass's tasks (see `certify::carried`), is the
-    // first design where it is at least as good as the fast path's.
+    // The last pass's design, carried to this pass's tasks (see `certify::carried`).
     let carried = run.candidate.as_ref().and_then(|c| {
         crate::certify::carried(problem, b, &tasks, options.objective, &c.x, &c.springs)
     });
-    // The fast path's record of spring starts goes with its design only (the spring choice
-    // reuses it for the same counterweights).
-    let (incumbent, record) = match (fast, carried) {
-        (Some(f), Some(c)) if c.value <= f.value => (Some(c), None),
-        (Some(f), _) => (Some(f), record),
-        (None, c) => (c, None),
-    };
+    let (incumbent, record) = first_design(fast, carried);
+    let record = record.flatten();
     // The first design is accepted when it is within the gap tolerance of the bound;
     // otherwise the branch-and-bound certifies the optimum or proves that none exists.
     if let Some(design) = &incumbent
@@ -542,6 +532,22 @@ fn step(
             nodes,
             search.as_ref().map(SearchState::restart),
         ))),
+    }
+}
+
+/// The first design of a pass and the record that goes with it: of the fast path's design
+/// (with its record `R`) and the last pass's design carried to this pass's tasks, the lower,
+/// ties to the carried one, which does not depend on the seed; the fast path's record of spring
+/// starts goes with its own design only (the spring choice reuses it for the same
+/// counterweights).
+fn first_design<R>(
+    fast: Option<(Design, R)>,
+    carried: Option<Design>,
+) -> (Option<Design>, Option<R>) {
+    match (fast, carried) {
+        (Some((f, _)), Some(c)) if c.value <= f.value => (Some(c), None),
+        (Some((f, r)), _) => (Some(f), Some(r)),
+        (None, c) => (c, None),
     }
 }
 

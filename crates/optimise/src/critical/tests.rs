@@ -2053,3 +2053,37 @@ fn the_dense_method_agrees_with_clarabel_on_the_boxes_of_three_variants() {
     );
     assert!(empty > 0 && solved > 0, "{empty} empty, {solved} solved");
 }
+
+/// The first design of a pass: the lower of the fast path's and the carried one, a tie to the
+/// carried one; the fast path's record only with its own design; either alone when the other
+/// is missing.
+#[test]
+fn the_first_design_is_the_lower_of_the_fast_and_the_carried_ties_to_the_carried() {
+    let design = |value: f64| Design {
+        x: DVector::from_vec(vec![value]),
+        cws: Vec::new(),
+        springs: Vec::new(),
+        value,
+    };
+    let pick = |fast: Option<f64>, carried: Option<f64>| {
+        let (d, r) = first_design(fast.map(|v| (design(v), "fast")), carried.map(design));
+        (d.map(|d| d.value), r)
+    };
+    assert_eq!(pick(Some(1.0), Some(2.0)), (Some(1.0), Some("fast")));
+    assert_eq!(pick(Some(2.0), Some(1.0)), (Some(1.0), None));
+    // A tie: the carried design (its x tells them apart).
+    let (d, r) = first_design(
+        Some((
+            Design {
+                x: DVector::from_vec(vec![7.0]),
+                ..design(1.5)
+            },
+            "fast",
+        )),
+        Some(design(1.5)),
+    );
+    assert_eq!((d.unwrap().x[0], r), (1.5, None));
+    assert_eq!(pick(Some(3.0), None), (Some(3.0), Some("fast")));
+    assert_eq!(pick(None, Some(4.0)), (Some(4.0), None));
+    assert_eq!(pick(None, None), (None, None));
+}
