@@ -11,7 +11,8 @@
 //! moved 545 rank numbers. Before a search returns, every relaxed point it closed unopened or
 //! left open is tried in bound order for a design, where the point's own objective is below the
 //! best design's (as a box is when it is opened); a better verified design replaces the best
-//! one. Both seeds' searches of m5 + K32 + K73 then end in the lower valley.
+//! one. Both seeds' first passes of m5 + K32 + K73 then end at the same design, to the bit
+//! (the passes after start from it: `carried`).
 
 use nalgebra::DVector;
 

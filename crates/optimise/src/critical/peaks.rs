@@ -415,9 +415,9 @@ pub fn delta_r(unbalanced: &Indicators, force: &[f64], moment: &[f64]) -> Option
 /// The grid on which spring options' ΔR are compared, percentage points: scores in the same
 /// cell ([`delta_r_cell`]) tie, and the earlier option wins.
 ///
-/// The options are scored on the reaction tasks, where several often have the same ΔR in exact
-/// arithmetic (the joints their springs load peak below the unbalanced mechanism's there), and
-/// then differ only by rounding. Compared exactly, such a tie went to whichever option the last
+/// The options are scored on the reaction tasks, where several can have the same ΔR up to
+/// rounding (its terms are `γ·max(0, ΔF)` and alike, so a joint whose peak stays below the
+/// unbalanced mechanism's adds nothing whatever the springs do to it). Compared exactly, such a tie went to whichever option the last
 /// bits of the counterweights favoured: on the palletizer at Dmax 3, two runs whose
 /// m5 + K53 + K54 designs differed by 1e-14 of the mass chose different options from the same
 /// 32, whose ΔR over all tasks are 0.347 and 0.328 %. Scores closer than 1e-9 pp are below any
