@@ -828,11 +828,8 @@ pub fn branch_and_bound(
         // A design is sought where it could improve on the best one: where the relaxed point's
         // true objective is below it (the refinement only moves to feasibility nearby).
         let promising = |z: &DVector<f64>| {
-            best.as_ref().is_none_or(|d| {
-                let (_, value, _) =
-                    merit(problem, tasks, objective, &project_fixed(problem, z), scale);
-                value < d.value
-            })
+            best.as_ref()
+                .is_none_or(|d| promises(problem, tasks, objective, z, scale, d.value))
         };
         let was_promising = current.z.as_ref().is_some_and(&promising);
         let found = match &current.z {
@@ -954,9 +951,24 @@ pub(crate) fn descended(
     design: Design,
     scale: f64,
 ) -> Design {
-    polish::descend(problem, b, tasks, objective, &design, scale)
+    polish::descend(problem, b, tasks, objective, &design.x, scale)
         .filter(|p| p.value < design.value)
         .unwrap_or(design)
+}
+
+/// Whether the relaxed point `z` promises a design below `value`: its own objective (fixed
+/// coordinates projected) is. A box's point is tried for a design only then (the refinement
+/// only moves to feasibility nearby).
+fn promises(
+    problem: &VariantProblem,
+    tasks: &[Arc<TaskTorques>],
+    objective: Objective,
+    z: &DVector<f64>,
+    scale: f64,
+    value: f64,
+) -> bool {
+    let (_, own, _) = merit(problem, tasks, objective, &project_fixed(problem, z), scale);
+    own < value
 }
 
 /// The best of `design` and the verified designs found at the `untried` relaxed points (module
@@ -975,14 +987,7 @@ fn best_of_untried(
         .in_bound_order()
         .into_iter()
         .fold(design, |best, z| {
-            let (_, value, _) = merit(
-                problem,
-                tasks,
-                objective,
-                &project_fixed(problem, &z),
-                scale,
-            );
-            if value >= best.value {
+            if !promises(problem, tasks, objective, &z, scale, best.value) {
                 return best;
             }
             match design_at(problem, b, tasks, objective, &z, scale) {
@@ -1013,16 +1018,7 @@ pub(crate) fn carried(
     let scale = objective_scale(tasks);
     match verified_design(problem, tasks, objective, springs.to_vec(), x.clone()) {
         Some(d) => Some(descended(problem, b, tasks, objective, d, scale)),
-        None => {
-            // Only the start's lifted point matters to the descent.
-            let start = Design {
-                x: x.clone(),
-                cws: Vec::new(),
-                springs: Vec::new(),
-                value: f64::INFINITY,
-            };
-            polish::descend(problem, b, tasks, objective, &start, scale)
-        }
+        None => polish::descend(problem, b, tasks, objective, x, scale),
     }
 }
 

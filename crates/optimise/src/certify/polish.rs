@@ -25,21 +25,22 @@ use crate::refine::{
 use crate::springs::realize_springs;
 use crate::torque::TaskTorques;
 
-/// The best verified design met on a descent from `design` (`None` when the variant has no
-/// counterweight and spring to trade, or no step met every bound).
+/// The best verified design met on a descent from the full lifted point `x` (a design's, or
+/// one that misses a bound or limit: the descent's merit is penalised there); `None` when the
+/// variant has no counterweight and spring to trade, or no step met every bound.
 pub(super) fn descend(
     problem: &VariantProblem,
     b: &DVector<f64>,
     tasks: &[Arc<TaskTorques>],
     objective: Objective,
-    design: &Design,
+    x: &DVector<f64>,
     scale: f64,
 ) -> Option<Design> {
     if problem.springs.is_empty() || problem.counterweights.is_empty() {
         return None;
     }
     let directions = counterweight_directions(problem);
-    let start = free_coordinates(problem, &design.x)?;
+    let start = free_coordinates(problem, x)?;
     let mut best: Option<Design> = None;
     minimise_along(&start, &directions, |z| {
         let Some(z) = project_radius(problem, z, &directions) else {
